@@ -1,0 +1,72 @@
+#pragma once
+// The estimator: IMU in, stereo frames in, one pose per frame out. It
+// initializes, adds one state per frame (predicted by the IMU and linked by a
+// preintegrated IMU factor) and hands the frame to the policy, which works
+// on the window.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "vio/estimator/estimator_options.h"
+#include "vio/estimator/initializer.h"
+#include "vio/estimator/policy.h"
+#include "vio/estimator/window.h"
+
+namespace vio {
+
+/// Wall time of one frame's stages [ms].
+struct FrameTiming {
+  double propagate_ms = 0;  ///< preintegration and the new state
+  PolicyTiming policy;
+  double total_ms = 0;
+};
+
+/// The estimate after one frame.
+struct FrameEstimate {
+  Timestamp t_ns = 0;
+  bool initialized = false;   ///< false while waiting for initialization
+  Eigen::Vector3d p_w_b = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q_w_b = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d v_w_b = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_bias = Eigen::Vector3d::Zero();
+  int num_states = 0;
+  int num_landmarks = 0;
+  int num_observations = 0;   ///< stereo observations in the frame
+  FrameTiming timing;
+};
+
+class Estimator {
+ public:
+  Estimator(const EstimatorOptions& options, const ImuCalibration& imu, const RectifiedStereo& stereo);
+
+  /// IMU samples must arrive in time order, before the frames they precede.
+  void AddImu(const ImuSample& sample);
+  /// Starts from a known state at the first frame (--init=groundtruth).
+  void SetInitialState(const InitialState& state);
+  /// Processes one stereo frame; IMU up to its time must have been added.
+  FrameEstimate ProcessFrame(const StereoFrame& frame);
+
+  const Window& window() const { return window_; }
+  /// Why static initialization has not happened yet (empty once initialized).
+  const std::string& waiting_reason() const { return waiting_reason_; }
+
+ private:
+  bool Initialize(const StereoFrame& frame);
+  void AddFirstState(const InitialState& initial);
+  void AddPropagatedState(Timestamp t_ns);
+  FrameEstimate Estimate(const StereoFrame& frame) const;
+  void PruneImu(Timestamp before_ns);
+
+  EstimatorOptions options_;
+  ImuCalibration imu_calibration_;
+  Window window_;
+  std::unique_ptr<Policy> policy_;
+  std::vector<ImuSample> imu_;
+  std::optional<InitialState> given_initial_state_;
+  StateId last_state_;
+  std::int64_t next_state_id_ = 0;
+  std::string waiting_reason_;
+};
+
+}  // namespace vio

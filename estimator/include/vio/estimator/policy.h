@@ -1,0 +1,48 @@
+#pragma once
+// A policy decides, each frame, which of the three operations on the one cost
+// to apply (paper §2.3): which measurements enter the cost, how many
+// Gauss-Newton steps to take, and what to marginalize or drop. Policies are
+// functions over a Window; they hold no estimation state of their own beyond
+// bookkeeping (e.g. which tracks are pending).
+#include <memory>
+
+#include "vio/estimator/estimator_options.h"
+#include "vio/estimator/window.h"
+
+namespace vio {
+
+/// Wall time of a policy's steps in one frame [ms].
+struct PolicyTiming {
+  double build_ms = 0;        ///< adding landmarks and observations
+  double solve_ms = 0;        ///< Gauss-Newton
+  double marginalize_ms = 0;  ///< marginalization and dropping
+  int solver_iterations = 0;
+};
+
+class Policy {
+ public:
+  virtual ~Policy() = default;
+  /// Called once per frame after `new_state` (linked to the previous state
+  /// by its IMU factor) was added to the window.
+  virtual PolicyTiming Update(const StereoFrame& frame, StateId new_state, Window& window) = 0;
+};
+
+/// The policy named by options.policy.policy. Throws std::invalid_argument
+/// for an unknown name.
+std::unique_ptr<Policy> MakePolicy(const EstimatorOptions& options);
+
+// ---- building blocks shared by the policies ------------------------------
+
+/// Adds the frame's observations: of landmarks already in the window, and of
+/// new landmarks stereo-triangulated from `state`'s current pose (those with
+/// too small a disparity or too large a depth are skipped and counted).
+/// Returns the number of new landmarks.
+int AddStereoObservations(const StereoFrame& frame, StateId state, const ModelOptions& model, Window& window);
+
+/// Landmarks observed from no state other than those in `leaving`.
+std::vector<LandmarkId> LandmarksOnlySeenFrom(const Window& window, const std::vector<StateId>& leaving);
+
+/// Landmarks observed from any of `states`.
+std::vector<LandmarkId> LandmarksSeenFrom(const Window& window, const std::vector<StateId>& states);
+
+}  // namespace vio

@@ -1,0 +1,141 @@
+#pragma once
+// The window manager: the ONE place where the cost is assembled. It owns the
+// Ceres problem, its parameter blocks (states and landmarks, keyed by typed
+// ids) and its residual blocks (IMU factors, stereo observations, priors), and
+// offers the paper's three operations on that one cost (ch. 2-3):
+//   build     AddState / AddImuFactor / AddLandmark / AddObservation / priors
+//   GN steps  Solve
+//   marginalize  Marginalize(states, landmarks): Schur complement into one
+//             linearized prior (vio_marginalization) on the same problem;
+//             Drop*(): remove without keeping their information.
+// Policies (policy.h) are functions over a Window.
+#include <map>
+#include <memory>
+#include <set>
+#include <vector>
+
+#include <ceres/ceres.h>
+
+#include "vio/estimator/estimator_options.h"
+#include "vio/estimator/imu_preintegration.h"
+#include "vio/estimator/types.h"
+
+namespace vio {
+
+/// One estimator state: a frame's pose and speed/bias, as parameter blocks.
+struct State {
+  StateId id;
+  Timestamp t_ns = 0;
+  double pose[7] = {0, 0, 0, 0, 0, 0, 1};  ///< [p_w_b, q_w_b (x y z w)]
+  double speed_bias[9] = {};               ///< [v_w_b, b_g, b_a]
+
+  Eigen::Vector3d p_w_b() const { return Eigen::Vector3d(pose[0], pose[1], pose[2]); }
+  Eigen::Quaterniond q_w_b() const { return Eigen::Quaterniond(pose[6], pose[3], pose[4], pose[5]); }
+  Eigen::Vector3d v_w_b() const { return Eigen::Vector3d(speed_bias[0], speed_bias[1], speed_bias[2]); }
+  Eigen::Vector3d gyro_bias() const { return Eigen::Vector3d(speed_bias[3], speed_bias[4], speed_bias[5]); }
+  Eigen::Vector3d accel_bias() const { return Eigen::Vector3d(speed_bias[6], speed_bias[7], speed_bias[8]); }
+  void SetPose(const Eigen::Vector3d& p_w_b, const Eigen::Quaterniond& q_w_b);
+  void SetSpeedBias(const Eigen::Vector3d& v_w_b, const Eigen::Vector3d& b_g, const Eigen::Vector3d& b_a);
+};
+
+/// One landmark: a world point and the states that observe it in the window.
+struct Landmark {
+  LandmarkId id;
+  double p_w[3] = {};               ///< [m]
+  std::set<StateId> observed_from;  ///< states with an observation residual
+
+  Eigen::Vector3d position() const { return Eigen::Vector3d(p_w[0], p_w[1], p_w[2]); }
+};
+
+/// A Gaussian prior on one state (first-state initialization).
+struct StatePrior {
+  Eigen::Matrix<double, 6, 6> pose_covariance;    ///< over the pose tangent [dp (m, world), dtheta (rad, body)]
+  Eigen::Matrix<double, 9, 1> speed_bias_sigma;   ///< [v (m/s), b_g (rad/s), b_a (m/s^2)]
+};
+
+/// What one Solve did.
+struct SolveReport {
+  int iterations = 0;
+  double initial_cost = 0;
+  double final_cost = 0;
+  bool usable = true;
+};
+
+class Window {
+ public:
+  Window(const ModelOptions& model, const RectifiedStereo& stereo);
+  ~Window();
+  Window(const Window&) = delete;
+  Window& operator=(const Window&) = delete;
+
+  // ---- build the cost -------------------------------------------------------
+  State& AddState(StateId id, Timestamp t_ns);
+  /// Links two states by an IMU factor over the preintegrated interval.
+  void AddImuFactor(StateId from, StateId to, ImuPreintegration preintegration);
+  /// Prior on one state at its current value (first state).
+  void AddStatePrior(StateId id, const StatePrior& prior);
+  Landmark& AddLandmark(LandmarkId id, const Eigen::Vector3d& p_w);
+  /// Stereo observation z = (u_L, u_R, v) [px] of `landmark` from `state`.
+  void AddObservation(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px);
+
+  // ---- Gauss-Newton ---------------------------------------------------------
+  SolveReport Solve(const SolverOptions& options);
+  /// Re-preintegrates IMU factors whose gyro-bias linearization moved too far.
+  int RefreshImuFactors(double gyro_bias_threshold);
+
+  // ---- marginalize or drop ---------------------------------------------------
+  /// Marginalizes the states and landmarks (with every residual touching them)
+  /// into one linearized prior on what they were connected to.
+  void Marginalize(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks);
+  /// Removes without keeping information.
+  void DropObservation(StateId state, LandmarkId landmark);
+  void DropLandmark(LandmarkId landmark);
+
+  // ---- queries ---------------------------------------------------------------
+  const std::map<StateId, State>& states() const { return states_; }
+  const std::map<LandmarkId, Landmark>& landmarks() const { return landmarks_; }
+  State& state(StateId id);
+  const State& state(StateId id) const;
+  bool HasState(StateId id) const { return states_.count(id) > 0; }
+  bool HasLandmark(LandmarkId id) const { return landmarks_.count(id) > 0; }
+  const Landmark& landmark(LandmarkId id) const;
+  /// Whitened stereo reprojection error of one observation [sigma].
+  double ObservationError(StateId state, LandmarkId landmark) const;
+  const RectifiedStereo& stereo() const { return stereo_; }
+  int num_priors() const { return static_cast<int>(priors_.size()); }
+  ceres::Problem& problem() { return *problem_; }
+
+ private:
+  struct ImuEdge {
+    StateId from;
+    StateId to;
+    ImuPreintegration preintegration;
+    ceres::ResidualBlockId residual = nullptr;
+  };
+  struct Observation {
+    Eigen::Vector3d z_px;
+    ceres::ResidualBlockId residual = nullptr;
+  };
+  struct Prior {
+    ceres::ResidualBlockId residual = nullptr;
+    std::vector<const double*> blocks;
+  };
+  using ObservationKey = std::pair<StateId, LandmarkId>;
+
+  void AddImuResidual(ImuEdge& edge);
+  void ForgetResidualsOf(const std::set<const double*>& removed_blocks);
+  void RemoveStateBookkeeping(StateId id);
+
+  ModelOptions model_;
+  RectifiedStereo stereo_;
+  std::unique_ptr<ceres::Manifold> pose_manifold_;
+  std::unique_ptr<ceres::LossFunction> loss_;
+  std::unique_ptr<ceres::Problem> problem_;
+  std::map<StateId, State> states_;
+  std::map<LandmarkId, Landmark> landmarks_;
+  std::map<StateId, ImuEdge> imu_edges_;  ///< keyed by the later state (`to`)
+  std::map<ObservationKey, Observation> observations_;
+  std::vector<Prior> priors_;
+};
+
+}  // namespace vio

@@ -1,0 +1,138 @@
+#include "vio/estimator/estimator.h"
+
+#include <chrono>
+
+#include <glog/logging.h>
+
+namespace vio {
+namespace {
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+Estimator::Estimator(const EstimatorOptions& options, const ImuCalibration& imu, const RectifiedStereo& stereo)
+    : options_(options), imu_calibration_(imu), window_(options.model, stereo), policy_(MakePolicy(options)) {
+  imu_calibration_.gyro_noise_density *= options.model.imu_noise_scale;
+  imu_calibration_.accel_noise_density *= options.model.imu_noise_scale;
+  imu_calibration_.gyro_random_walk *= options.model.imu_noise_scale;
+  imu_calibration_.accel_random_walk *= options.model.imu_noise_scale;
+}
+
+void Estimator::AddImu(const ImuSample& sample) {
+  CHECK(imu_.empty() || sample.t_ns > imu_.back().t_ns) << "IMU samples out of order at " << sample.t_ns;
+  imu_.push_back(sample);
+}
+
+void Estimator::SetInitialState(const InitialState& state) { given_initial_state_ = state; }
+
+FrameEstimate Estimator::ProcessFrame(const StereoFrame& frame) {
+  const auto start = std::chrono::steady_clock::now();
+  FrameTiming timing;
+  if (!last_state_.valid()) {
+    if (!Initialize(frame)) {
+      FrameEstimate waiting;
+      waiting.t_ns = frame.t_ns;
+      return waiting;
+    }
+  } else {
+    AddPropagatedState(frame.t_ns);
+  }
+  timing.propagate_ms = MillisecondsSince(start);
+  timing.policy = policy_->Update(frame, last_state_, window_);
+  PruneImu(window_.states().begin()->second.t_ns);
+  FrameEstimate estimate = Estimate(frame);
+  timing.total_ms = MillisecondsSince(start);
+  estimate.timing = timing;
+  return estimate;
+}
+
+bool Estimator::Initialize(const StereoFrame& frame) {
+  if (given_initial_state_) {
+    InitialState initial = *given_initial_state_;
+    initial.t_ns = frame.t_ns;
+    AddFirstState(initial);
+    return true;
+  }
+  const StaticInitResult result = InitializeStatic(imu_, frame.t_ns, options_.init);
+  if (!result.state) {
+    if (result.reason != waiting_reason_) LOG(WARNING) << "waiting for static initialization: " << result.reason;
+    waiting_reason_ = result.reason;
+    return false;
+  }
+  LOG(INFO) << "static initialization at t=" << NanosToSeconds(frame.t_ns) << " s";
+  AddFirstState(*result.state);
+  return true;
+}
+
+void Estimator::AddFirstState(const InitialState& initial) {
+  last_state_ = StateId(next_state_id_++);
+  State& s = window_.AddState(last_state_, initial.t_ns);
+  s.SetPose(initial.p_w_b, initial.q_w_b);
+  s.SetSpeedBias(initial.v_w_b, initial.gyro_bias, initial.accel_bias);
+  const InitOptions& o = options_.init;
+  StatePrior prior;
+  // Roll/pitch and yaw are world-frame angles; the tangent's rotation is in
+  // the body frame: Sigma_body = R_w_b^T Sigma_world R_w_b.
+  const Eigen::Matrix3d R_w_b = initial.q_w_b.toRotationMatrix();
+  const Eigen::Vector3d rotation_sigma_w(o.prior_tilt_sigma, o.prior_tilt_sigma, o.prior_yaw_sigma);
+  prior.pose_covariance.setZero();
+  prior.pose_covariance.topLeftCorner<3, 3>() =
+      Eigen::Matrix3d::Identity() * (o.prior_position_sigma * o.prior_position_sigma);
+  prior.pose_covariance.bottomRightCorner<3, 3>() =
+      R_w_b.transpose() * rotation_sigma_w.cwiseAbs2().asDiagonal() * R_w_b;
+  prior.speed_bias_sigma << Eigen::Vector3d::Constant(o.prior_velocity_sigma),
+      Eigen::Vector3d::Constant(o.prior_gyro_bias_sigma), Eigen::Vector3d::Constant(o.prior_accel_bias_sigma);
+  window_.AddStatePrior(last_state_, prior);
+  waiting_reason_.clear();
+}
+
+// Predicts the new state from the last one through the preintegrated IMU
+// (Forster et al. eq. 33) and links the two by an IMU factor.
+void Estimator::AddPropagatedState(Timestamp t_ns) {
+  const State& last = window_.state(last_state_);
+  ImuPreintegration pre = PreintegrateBetween(imu_, last.t_ns, t_ns, ImuBias{last.gyro_bias(), last.accel_bias()},
+                                              imu_calibration_);
+  const Eigen::Vector3d g_w(0, 0, -options_.model.gravity);
+  const double dt = NanosToSeconds(t_ns - last.t_ns);
+  const Eigen::Matrix3d R_w_i = last.q_w_b().toRotationMatrix();
+  const Eigen::Vector3d p = last.p_w_b() + last.v_w_b() * dt + 0.5 * g_w * dt * dt + R_w_i * pre.deltas().delta_p;
+  const Eigen::Vector3d v = last.v_w_b() + g_w * dt + R_w_i * pre.deltas().delta_v;
+  const Eigen::Quaterniond q = last.q_w_b() * pre.deltas().delta_q;
+  const Eigen::Vector3d b_g = last.gyro_bias(), b_a = last.accel_bias();
+  const StateId previous = last_state_;
+  last_state_ = StateId(next_state_id_++);
+  State& s = window_.AddState(last_state_, t_ns);
+  s.SetPose(p, q);
+  s.SetSpeedBias(v, b_g, b_a);
+  window_.AddImuFactor(previous, last_state_, std::move(pre));
+}
+
+FrameEstimate Estimator::Estimate(const StereoFrame& frame) const {
+  const State& s = window_.state(last_state_);
+  FrameEstimate e;
+  e.t_ns = frame.t_ns;
+  e.initialized = true;
+  e.p_w_b = s.p_w_b();
+  e.q_w_b = s.q_w_b();
+  e.v_w_b = s.v_w_b();
+  e.gyro_bias = s.gyro_bias();
+  e.accel_bias = s.accel_bias();
+  e.num_states = static_cast<int>(window_.states().size());
+  e.num_landmarks = static_cast<int>(window_.landmarks().size());
+  e.num_observations = static_cast<int>(frame.observations.size());
+  return e;
+}
+
+// Keeps the IMU samples the window may still need (re-preintegration uses the
+// factor's own copy) plus one before, for interpolation at the boundary.
+void Estimator::PruneImu(Timestamp before_ns) {
+  auto it = std::lower_bound(imu_.begin(), imu_.end(), before_ns,
+                             [](const ImuSample& m, Timestamp t) { return m.t_ns < t; });
+  if (it != imu_.begin()) --it;
+  imu_.erase(imu_.begin(), it);
+}
+
+}  // namespace vio

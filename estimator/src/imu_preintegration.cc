@@ -1,0 +1,226 @@
+#include "vio/estimator/imu_preintegration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
+#include <glog/logging.h>
+
+#include "vio/estimator/so3.h"
+
+namespace vio {
+namespace {
+
+using Matrix15d = ImuPreintegration::Matrix15d;
+using Matrix15x12d = Eigen::Matrix<double, 15, 12>;
+constexpr int kR = ImuPreintegration::kRotation;
+constexpr int kV = ImuPreintegration::kVelocity;
+constexpr int kP = ImuPreintegration::kPosition;
+constexpr int kBg = ImuPreintegration::kBiasGyro;
+constexpr int kBa = ImuPreintegration::kBiasAccel;
+
+// Noise columns of G: [n_g, n_a, n_bg, n_ba].
+constexpr int kNoiseGyro = 0;
+constexpr int kNoiseAccel = 3;
+constexpr int kNoiseGyroWalk = 6;
+constexpr int kNoiseAccelWalk = 9;
+
+/// The linearization of one midpoint step: error_{k+1} = F error_k + G n.
+struct StepLinearization {
+  Matrix15d F = Matrix15d::Identity();
+  Matrix15x12d G = Matrix15x12d::Zero();
+};
+
+/// F and G of one step (see the header comment for the step itself):
+///   dphi' = dR^T dphi - Jr dt (db_g + n_g)
+///   dacc  = -1/2 R_k [a_a]x dphi - 1/2 R_k1 [a_b]x dphi' - 1/2 (R_k + R_k1)(db_a + n_a)
+///   dv'   = dv + dacc dt,   dp' = dp + dv dt + dacc dt^2 / 2
+///   db'   = db + n_b
+StepLinearization LinearizeStep(const Eigen::Matrix3d& R_k, const Eigen::Matrix3d& R_k1,
+                                const Eigen::Vector3d& theta, const Eigen::Vector3d& accel_a,
+                                const Eigen::Vector3d& accel_b, double dt) {
+  const Eigen::Matrix3d dR_transpose = so3::Exp(theta).transpose();
+  const Eigen::Matrix3d Jr_dt = so3::RightJacobian(theta) * dt;
+  const Eigen::Matrix3d R_k1_accel_b_hat = R_k1 * so3::Hat(accel_b);
+  const Eigen::Matrix3d dacc_dphi =
+      -0.5 * R_k * so3::Hat(accel_a) - 0.5 * R_k1_accel_b_hat * dR_transpose;
+  const Eigen::Matrix3d dacc_dbg = 0.5 * R_k1_accel_b_hat * Jr_dt;
+  const Eigen::Matrix3d dacc_dba = -0.5 * (R_k + R_k1);
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+
+  StepLinearization lin;
+  lin.F.block<3, 3>(kR, kR) = dR_transpose;
+  lin.F.block<3, 3>(kR, kBg) = -Jr_dt;
+  lin.F.block<3, 3>(kV, kR) = dacc_dphi * dt;
+  lin.F.block<3, 3>(kV, kBg) = dacc_dbg * dt;
+  lin.F.block<3, 3>(kV, kBa) = dacc_dba * dt;
+  lin.F.block<3, 3>(kP, kR) = 0.5 * dacc_dphi * dt * dt;
+  lin.F.block<3, 3>(kP, kV) = I * dt;
+  lin.F.block<3, 3>(kP, kBg) = 0.5 * dacc_dbg * dt * dt;
+  lin.F.block<3, 3>(kP, kBa) = 0.5 * dacc_dba * dt * dt;
+
+  // Measurement noise enters exactly like the bias errors; random walks
+  // drive the bias errors.
+  lin.G.block<3, 3>(kR, kNoiseGyro) = lin.F.block<3, 3>(kR, kBg);
+  lin.G.block<3, 3>(kV, kNoiseGyro) = lin.F.block<3, 3>(kV, kBg);
+  lin.G.block<3, 3>(kP, kNoiseGyro) = lin.F.block<3, 3>(kP, kBg);
+  lin.G.block<3, 3>(kV, kNoiseAccel) = lin.F.block<3, 3>(kV, kBa);
+  lin.G.block<3, 3>(kP, kNoiseAccel) = lin.F.block<3, 3>(kP, kBa);
+  lin.G.block<3, 3>(kBg, kNoiseGyroWalk) = I;
+  lin.G.block<3, 3>(kBa, kNoiseAccelWalk) = I;
+  return lin;
+}
+
+}  // namespace
+
+ImuPreintegration::ImuPreintegration(const ImuBias& linearization_bias,
+                                     const ImuCalibration& calibration)
+    : linearization_bias_(linearization_bias),
+      gyro_noise_density_(calibration.gyro_noise_density),
+      accel_noise_density_(calibration.accel_noise_density),
+      gyro_random_walk_(calibration.gyro_random_walk),
+      accel_random_walk_(calibration.accel_random_walk) {
+  if (!calibration.T_b_i.isApprox(Eigen::Isometry3d::Identity(), 1e-9)) {
+    throw std::invalid_argument(
+        "ImuPreintegration: ImuCalibration::T_b_i must be the identity (body = IMU)");
+  }
+}
+
+void ImuPreintegration::Integrate(const ImuSample& a, const ImuSample& b) {
+  CHECK_GT(b.t_ns, a.t_ns) << "IMU samples must be strictly increasing in time";
+  const Step step{NanosToSeconds(b.t_ns - a.t_ns), a.gyro_rad_s, b.gyro_rad_s, a.accel_m_s2,
+                  b.accel_m_s2};
+  steps_.push_back(step);
+  Propagate(step);
+}
+
+void ImuPreintegration::Integrate(double dt_s, const Eigen::Vector3d& gyro_rad_s,
+                                  const Eigen::Vector3d& accel_m_s2) {
+  CHECK_GT(dt_s, 0.0) << "IMU integration step must be positive";
+  const Step step{dt_s, gyro_rad_s, gyro_rad_s, accel_m_s2, accel_m_s2};
+  steps_.push_back(step);
+  Propagate(step);
+}
+
+void ImuPreintegration::Append(const ImuPreintegration& next) {
+  for (const Step& step : next.steps_) {
+    steps_.push_back(step);
+    Propagate(step);
+  }
+}
+
+void ImuPreintegration::Reintegrate(const ImuBias& new_linearization_bias) {
+  linearization_bias_ = new_linearization_bias;
+  Reset();
+  for (const Step& step : steps_) Propagate(step);
+}
+
+bool ImuPreintegration::NeedsReintegration(const ImuBias& bias, double gyro_threshold_rad_s,
+                                           double accel_threshold_m_s2) const {
+  const double gyro_change = (bias.gyro - linearization_bias_.gyro).cwiseAbs().maxCoeff();
+  const double accel_change = (bias.accel - linearization_bias_.accel).cwiseAbs().maxCoeff();
+  return gyro_change > gyro_threshold_rad_s || accel_change > accel_threshold_m_s2;
+}
+
+ImuPreintegration::Deltas ImuPreintegration::CorrectedDeltas(const ImuBias& bias) const {
+  const Eigen::Vector3d dbg = bias.gyro - linearization_bias_.gyro;
+  const Eigen::Vector3d dba = bias.accel - linearization_bias_.accel;
+  Deltas corrected;
+  corrected.delta_q = (deltas_.delta_q * so3::ExpQuaternion(d_delta_R_d_bg() * dbg)).normalized();
+  corrected.delta_v = deltas_.delta_v + d_delta_v_d_bg() * dbg + d_delta_v_d_ba() * dba;
+  corrected.delta_p = deltas_.delta_p + d_delta_p_d_bg() * dbg + d_delta_p_d_ba() * dba;
+  return corrected;
+}
+
+ImuPreintegration::Matrix15d ImuPreintegration::SqrtInformation() const {
+  CHECK(!steps_.empty()) << "SqrtInformation of an empty preintegration";
+  const Matrix15d symmetric = 0.5 * (covariance_ + covariance_.transpose());
+  const Matrix15d information = symmetric.llt().solve(Matrix15d::Identity());
+  const Eigen::LLT<Matrix15d> llt(0.5 * (information + information.transpose()));
+  CHECK(llt.info() == Eigen::Success) << "IMU preintegration covariance is not positive definite";
+  return llt.matrixU();
+}
+
+void ImuPreintegration::Reset() {
+  deltas_ = Deltas();
+  delta_time_s_ = 0.0;
+  covariance_.setZero();
+  jacobian_.setIdentity();
+}
+
+void ImuPreintegration::Propagate(const Step& step) {
+  const double dt = step.dt_s;
+  const Eigen::Vector3d omega =
+      0.5 * (step.gyro_a + step.gyro_b) - linearization_bias_.gyro;
+  const Eigen::Vector3d accel_a = step.accel_a - linearization_bias_.accel;
+  const Eigen::Vector3d accel_b = step.accel_b - linearization_bias_.accel;
+  const Eigen::Vector3d theta = omega * dt;
+
+  const Eigen::Quaterniond q_k1 = (deltas_.delta_q * so3::ExpQuaternion(theta)).normalized();
+  const Eigen::Matrix3d R_k = deltas_.delta_q.toRotationMatrix();
+  const Eigen::Matrix3d R_k1 = q_k1.toRotationMatrix();
+  const Eigen::Vector3d acc = 0.5 * (R_k * accel_a + R_k1 * accel_b);
+
+  const StepLinearization lin = LinearizeStep(R_k, R_k1, theta, accel_a, accel_b, dt);
+  Eigen::Matrix<double, 12, 1> noise_variance;
+  noise_variance << Eigen::Vector3d::Constant(gyro_noise_density_ * gyro_noise_density_ / dt),
+      Eigen::Vector3d::Constant(accel_noise_density_ * accel_noise_density_ / dt),
+      Eigen::Vector3d::Constant(gyro_random_walk_ * gyro_random_walk_ * dt),
+      Eigen::Vector3d::Constant(accel_random_walk_ * accel_random_walk_ * dt);
+  covariance_ = lin.F * covariance_ * lin.F.transpose() +
+                lin.G * noise_variance.asDiagonal() * lin.G.transpose();
+  jacobian_ = lin.F * jacobian_;
+
+  deltas_.delta_p += deltas_.delta_v * dt + 0.5 * acc * dt * dt;
+  deltas_.delta_v += acc * dt;
+  deltas_.delta_q = q_k1;
+  delta_time_s_ += dt;
+}
+
+ImuSample InterpolateImuSample(const ImuSample& a, const ImuSample& b, Timestamp t_ns) {
+  CHECK_LT(a.t_ns, b.t_ns);
+  CHECK(a.t_ns <= t_ns && t_ns <= b.t_ns) << "interpolation time outside [a, b]";
+  const double s = static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
+  ImuSample sample;
+  sample.t_ns = t_ns;
+  sample.gyro_rad_s = (1.0 - s) * a.gyro_rad_s + s * b.gyro_rad_s;
+  sample.accel_m_s2 = (1.0 - s) * a.accel_m_s2 + s * b.accel_m_s2;
+  return sample;
+}
+
+namespace {
+
+[[noreturn]] void ThrowBadImuRange(const std::string& what, Timestamp t0_ns, Timestamp t1_ns) {
+  std::ostringstream message;
+  message << "PreintegrateBetween(t0=" << t0_ns << " ns, t1=" << t1_ns << " ns): " << what;
+  throw std::invalid_argument(message.str());
+}
+
+}  // namespace
+
+ImuPreintegration PreintegrateBetween(const std::vector<ImuSample>& samples, Timestamp t0_ns,
+                                      Timestamp t1_ns, const ImuBias& linearization_bias,
+                                      const ImuCalibration& calibration) {
+  if (t1_ns <= t0_ns) ThrowBadImuRange("t1 must be after t0", t0_ns, t1_ns);
+  if (samples.empty() || samples.front().t_ns > t0_ns || samples.back().t_ns < t1_ns) {
+    ThrowBadImuRange("IMU samples do not cover the interval", t0_ns, t1_ns);
+  }
+  const auto later_than_t0 = std::upper_bound(
+      samples.begin(), samples.end(), t0_ns,
+      [](Timestamp t, const ImuSample& sample) { return t < sample.t_ns; });
+  ImuPreintegration preintegration(linearization_bias, calibration);
+  ImuSample previous = InterpolateImuSample(*(later_than_t0 - 1), *later_than_t0, t0_ns);
+  for (auto it = later_than_t0; it != samples.end(); ++it) {
+    if (it->t_ns <= (it - 1)->t_ns) ThrowBadImuRange("IMU stamps not increasing", t0_ns, t1_ns);
+    const bool last = it->t_ns >= t1_ns;
+    const ImuSample next = last ? InterpolateImuSample(*(it - 1), *it, t1_ns) : *it;
+    preintegration.Integrate(previous, next);
+    if (last) break;
+    previous = next;
+  }
+  return preintegration;
+}
+
+}  // namespace vio

@@ -1,0 +1,60 @@
+#include "vio/estimator/policy.h"
+
+#include <stdexcept>
+
+#include "vio/estimator/pose_manifold.h"
+#include "vio/estimator/stereo_geometry.h"
+#include "vio/estimator/swf_policy.h"
+
+namespace vio {
+
+std::unique_ptr<Policy> MakePolicy(const EstimatorOptions& options) {
+  const std::string& name = options.policy.policy;
+  if (name == "swf") return std::make_unique<SwfPolicy>(options);
+  throw std::invalid_argument("unknown policy '" + name + "'");
+}
+
+int AddStereoObservations(const StereoFrame& frame, StateId state_id, const ModelOptions& model, Window& window) {
+  const State& s = window.state(state_id);
+  const Eigen::Isometry3d T_w_b = Eigen::Translation3d(s.p_w_b()) * s.q_w_b();
+  const Eigen::Isometry3d T_w_cl = T_w_b * window.stereo().T_b_cl;
+  int added = 0;
+  for (const StereoObservation& obs : frame.observations) {
+    if (!window.HasLandmark(obs.landmark)) {
+      const std::optional<Eigen::Vector3d> p_cl =
+          TriangulateRectified(obs.z_px, window.stereo(), model.min_disparity_px);
+      if (!p_cl || p_cl->z() > model.max_depth_m) continue;
+      window.AddLandmark(obs.landmark, T_w_cl * *p_cl);
+      ++added;
+    }
+    window.AddObservation(state_id, obs.landmark, obs.z_px);
+  }
+  return added;
+}
+
+std::vector<LandmarkId> LandmarksOnlySeenFrom(const Window& window, const std::vector<StateId>& leaving) {
+  std::vector<LandmarkId> out;
+  for (const auto& [id, landmark] : window.landmarks()) {
+    bool only = !landmark.observed_from.empty();
+    for (StateId observer : landmark.observed_from) {
+      only = only && std::find(leaving.begin(), leaving.end(), observer) != leaving.end();
+    }
+    if (only) out.push_back(id);
+  }
+  return out;
+}
+
+std::vector<LandmarkId> LandmarksSeenFrom(const Window& window, const std::vector<StateId>& states) {
+  std::vector<LandmarkId> out;
+  for (const auto& [id, landmark] : window.landmarks()) {
+    for (StateId s : states) {
+      if (landmark.observed_from.count(s)) {
+        out.push_back(id);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace vio

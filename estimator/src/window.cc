@@ -1,0 +1,241 @@
+#include "vio/estimator/window.h"
+
+#include <limits>
+
+#include <glog/logging.h>
+
+#include "vio/estimator/imu_factor.h"
+#include "vio/estimator/pose_manifold.h"
+#include "vio/estimator/pose_prior_factor.h"
+#include "vio/estimator/speed_bias_prior_factor.h"
+#include "vio/estimator/stereo_factor.h"
+#include "vio/marginalization/marginalizer.h"
+
+namespace vio {
+namespace {
+constexpr double kNoAccelThreshold = std::numeric_limits<double>::infinity();
+}  // namespace
+
+void State::SetPose(const Eigen::Vector3d& p_w_b, const Eigen::Quaterniond& q_w_b) {
+  const Eigen::Quaterniond q = q_w_b.normalized();
+  pose[0] = p_w_b.x(); pose[1] = p_w_b.y(); pose[2] = p_w_b.z();
+  pose[3] = q.x(); pose[4] = q.y(); pose[5] = q.z(); pose[6] = q.w();
+}
+
+void State::SetSpeedBias(const Eigen::Vector3d& v_w_b, const Eigen::Vector3d& b_g,
+                         const Eigen::Vector3d& b_a) {
+  Eigen::Map<Eigen::Matrix<double, 9, 1>> sb(speed_bias);
+  sb << v_w_b, b_g, b_a;
+}
+
+Window::Window(const ModelOptions& model, const RectifiedStereo& stereo)
+    : model_(model), stereo_(stereo), pose_manifold_(std::make_unique<PoseManifold>()) {
+  if (model_.huber_px > 0) loss_ = std::make_unique<ceres::HuberLoss>(model_.huber_px);
+  ceres::Problem::Options options;
+  options.enable_fast_removal = true;
+  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_ = std::make_unique<ceres::Problem>(options);
+}
+
+Window::~Window() = default;
+
+State& Window::state(StateId id) {
+  auto it = states_.find(id);
+  CHECK(it != states_.end()) << "no state " << id.value << " in the window";
+  return it->second;
+}
+
+const State& Window::state(StateId id) const {
+  auto it = states_.find(id);
+  CHECK(it != states_.end()) << "no state " << id.value << " in the window";
+  return it->second;
+}
+
+const Landmark& Window::landmark(LandmarkId id) const {
+  auto it = landmarks_.find(id);
+  CHECK(it != landmarks_.end()) << "no landmark " << id.value << " in the window";
+  return it->second;
+}
+
+State& Window::AddState(StateId id, Timestamp t_ns) {
+  CHECK(!HasState(id)) << "state " << id.value << " added twice";
+  State& s = states_[id];
+  s.id = id;
+  s.t_ns = t_ns;
+  problem_->AddParameterBlock(s.pose, kPoseSize, pose_manifold_.get());
+  problem_->AddParameterBlock(s.speed_bias, kSpeedBiasSize);
+  return s;
+}
+
+void Window::AddImuFactor(StateId from, StateId to, ImuPreintegration preintegration) {
+  CHECK(HasState(from) && HasState(to)) << "IMU factor between unknown states";
+  CHECK(imu_edges_.count(to) == 0) << "state " << to.value << " already has an incoming IMU factor";
+  ImuEdge& edge = imu_edges_.emplace(to, ImuEdge{from, to, std::move(preintegration)}).first->second;
+  AddImuResidual(edge);
+}
+
+void Window::AddImuResidual(ImuEdge& edge) {
+  State& a = state(edge.from);
+  State& b = state(edge.to);
+  const Eigen::Vector3d g_w(0, 0, -model_.gravity);
+  edge.residual = problem_->AddResidualBlock(ImuFactor::Create(edge.preintegration, g_w), nullptr,
+                                             a.pose, a.speed_bias, b.pose, b.speed_bias);
+}
+
+void Window::AddStatePrior(StateId id, const StatePrior& prior) {
+  State& s = state(id);
+  const Eigen::Matrix<double, 6, 6> information = prior.pose_covariance.inverse();
+  const Eigen::Matrix<double, 6, 6> sqrt_information = information.llt().matrixU();
+  Prior pose_prior{problem_->AddResidualBlock(PosePriorFactor::Create(s.p_w_b(), s.q_w_b(), sqrt_information),
+                                              nullptr, s.pose),
+                   {s.pose}};
+  const Eigen::Matrix<double, 9, 1> sigma = prior.speed_bias_sigma;
+  Prior sb_prior{problem_->AddResidualBlock(
+                     SpeedBiasPriorFactor::Create(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(s.speed_bias),
+                                                  sigma.cwiseInverse().asDiagonal().toDenseMatrix()),
+                     nullptr, s.speed_bias),
+                 {s.speed_bias}};
+  priors_.push_back(pose_prior);
+  priors_.push_back(sb_prior);
+}
+
+Landmark& Window::AddLandmark(LandmarkId id, const Eigen::Vector3d& p_w) {
+  CHECK(!HasLandmark(id)) << "landmark " << id.value << " added twice";
+  Landmark& l = landmarks_[id];
+  l.id = id;
+  Eigen::Map<Eigen::Vector3d>(l.p_w) = p_w;
+  problem_->AddParameterBlock(l.p_w, kLandmarkSize);
+  return l;
+}
+
+void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eigen::Vector3d& z_px) {
+  State& s = state(state_id);
+  auto it = landmarks_.find(landmark_id);
+  CHECK(it != landmarks_.end()) << "observation of unknown landmark " << landmark_id.value;
+  const ObservationKey key{state_id, landmark_id};
+  CHECK(observations_.count(key) == 0) << "landmark " << landmark_id.value << " observed twice in state "
+                                      << state_id.value;
+  ceres::ResidualBlockId residual = problem_->AddResidualBlock(
+      StereoFactor::Create(z_px, stereo_, model_.pixel_sigma), loss_.get(), s.pose, it->second.p_w);
+  observations_[key] = Observation{z_px, residual};
+  it->second.observed_from.insert(state_id);
+}
+
+SolveReport Window::Solve(const SolverOptions& options) {
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::DENSE_SCHUR;
+  solver.max_num_iterations = options.max_iterations;
+  solver.max_solver_time_in_seconds = options.max_solver_time_s;
+  solver.function_tolerance = options.function_tolerance;
+  solver.num_threads = options.num_threads;
+  solver.minimizer_progress_to_stdout = false;
+  solver.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, problem_.get(), &summary);
+  SolveReport report;
+  report.iterations = static_cast<int>(summary.iterations.size());
+  report.initial_cost = summary.initial_cost;
+  report.final_cost = summary.final_cost;
+  report.usable = summary.IsSolutionUsable();
+  return report;
+}
+
+int Window::RefreshImuFactors(double gyro_bias_threshold) {
+  int refreshed = 0;
+  for (auto& [to, edge] : imu_edges_) {
+    const State& from = state(edge.from);
+    const ImuBias bias{from.gyro_bias(), from.accel_bias()};
+    // delta_v and delta_p are linear in the accelerometer bias: the first-order
+    // correction is exact there, so only the gyro bias triggers.
+    if (!edge.preintegration.NeedsReintegration(bias, gyro_bias_threshold, kNoAccelThreshold)) continue;
+    problem_->RemoveResidualBlock(edge.residual);
+    edge.preintegration.Reintegrate(bias);
+    AddImuResidual(edge);
+    ++refreshed;
+  }
+  return refreshed;
+}
+
+void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vector<LandmarkId>& landmark_ids) {
+  std::vector<double*> blocks;
+  for (StateId id : state_ids) {
+    State& s = state(id);
+    blocks.push_back(s.pose);
+    blocks.push_back(s.speed_bias);
+  }
+  for (LandmarkId id : landmark_ids) {
+    auto it = landmarks_.find(id);
+    CHECK(it != landmarks_.end()) << "marginalizing unknown landmark " << id.value;
+    blocks.push_back(it->second.p_w);
+  }
+  if (blocks.empty()) return;
+  std::set<const double*> removed(blocks.begin(), blocks.end());
+  ForgetResidualsOf(removed);
+  ceres::ResidualBlockId prior = marginalization::MarginalizeBlocks(problem_.get(), blocks);
+  if (prior != nullptr) {
+    std::vector<double*> kept;
+    problem_->GetParameterBlocksForResidualBlock(prior, &kept);
+    priors_.push_back(Prior{prior, {kept.begin(), kept.end()}});
+  }
+  for (StateId id : state_ids) RemoveStateBookkeeping(id);
+  for (LandmarkId id : landmark_ids) landmarks_.erase(id);
+}
+
+// Drops the bookkeeping of every residual that touches a removed block; the
+// residual blocks themselves go with their parameter blocks.
+void Window::ForgetResidualsOf(const std::set<const double*>& removed) {
+  for (auto it = observations_.begin(); it != observations_.end();) {
+    const auto& [state_id, landmark_id] = it->first;
+    const bool gone = removed.count(states_.at(state_id).pose) ||
+                      removed.count(landmarks_.at(landmark_id).p_w);
+    if (gone) {
+      landmarks_.at(landmark_id).observed_from.erase(state_id);
+      it = observations_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  for (auto it = imu_edges_.begin(); it != imu_edges_.end();) {
+    const bool gone = removed.count(states_.at(it->second.from).pose) || removed.count(states_.at(it->first).pose);
+    it = gone ? imu_edges_.erase(it) : std::next(it);
+  }
+  for (auto it = priors_.begin(); it != priors_.end();) {
+    bool gone = false;
+    for (const double* b : it->blocks) gone = gone || removed.count(b) > 0;
+    it = gone ? priors_.erase(it) : std::next(it);
+  }
+}
+
+void Window::RemoveStateBookkeeping(StateId id) { states_.erase(id); }
+
+void Window::DropObservation(StateId state_id, LandmarkId landmark_id) {
+  auto it = observations_.find({state_id, landmark_id});
+  CHECK(it != observations_.end()) << "no observation of " << landmark_id.value << " in " << state_id.value;
+  problem_->RemoveResidualBlock(it->second.residual);
+  landmarks_.at(landmark_id).observed_from.erase(state_id);
+  observations_.erase(it);
+}
+
+void Window::DropLandmark(LandmarkId landmark_id) {
+  auto it = landmarks_.find(landmark_id);
+  CHECK(it != landmarks_.end()) << "dropping unknown landmark " << landmark_id.value;
+  std::set<const double*> removed{it->second.p_w};
+  ForgetResidualsOf(removed);
+  problem_->RemoveParameterBlock(it->second.p_w);
+  landmarks_.erase(landmark_id);
+}
+
+double Window::ObservationError(StateId state_id, LandmarkId landmark_id) const {
+  auto it = observations_.find({state_id, landmark_id});
+  CHECK(it != observations_.end()) << "no observation of " << landmark_id.value << " in " << state_id.value;
+  const State& s = state(state_id);
+  const Landmark& l = landmark(landmark_id);
+  double residual[3];
+  const double* params[2] = {s.pose, l.p_w};
+  std::unique_ptr<ceres::CostFunction> f(StereoFactor::Create(it->second.z_px, stereo_, model_.pixel_sigma));
+  f->Evaluate(params, residual, nullptr);
+  return Eigen::Map<Eigen::Vector3d>(residual).norm();
+}
+
+}  // namespace vio

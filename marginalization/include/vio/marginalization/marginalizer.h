@@ -1,0 +1,71 @@
+#pragma once
+// Marginalization on a live ceres::Problem (design paper, Algorithm 2), using
+// the problem's own residual blocks: no second assembly of the cost.
+//
+//   1. C2 = every residual block touching a block to marginalize (x_M);
+//      the Markov blanket x_K = the other parameter blocks those touch.
+//   2. Problem::Evaluate(C2) at the current values, loss functions applied
+//      (Ceres' robust-loss correction), gives r and J in the TANGENT space of
+//      every block with a manifold: H = J^T J, b = J^T r.
+//   3. Schur complement removes x_M: landmark-like blocks that share no
+//      residual with another marginalized block are eliminated block by block,
+//      the rest densely (SchurComplementOfUncoupledBlocks, SchurComplement).
+//   4. (H*, b*) -> square root (Jp, r0) (SqrtInformationFromHessian) ->
+//      MarginalizationPrior over x_K with x0 = the current values of x_K.
+//
+// Constant parameter blocks are treated as KNOWN: they never get a Jacobian
+// column. A constant block in the blanket is left out of the prior (its
+// residuals still inform the variable blanket blocks, conditioned on its
+// current value); if it is made variable later the prior says nothing about
+// it. A constant block in `to_marginalize` is conditioned on, not integrated
+// out: its residuals still feed the prior on the blanket.
+#include <memory>
+#include <vector>
+
+#include <ceres/problem.h>
+
+#include "vio/marginalization/linear_algebra.h"
+#include "vio/marginalization/marginalization_prior.h"
+
+namespace vio::marginalization {
+
+struct MarginalizationOptions {
+  /// Eigenvalues of H_MM (when pseudo-inverting it) and eigenvalues / pivots
+  /// of the marginal H* (when taking its square root) below this are zero.
+  RankThreshold rank_threshold;
+  /// Factorization of H* into the prior's square root. The blanket of a
+  /// sliding window easily has 300-700 dimensions, where kEigen costs
+  /// 0.1-0.7 s and kPivotedLdlt 15-20x less.
+  SqrtMethod sqrt_method = SqrtMethod::kPivotedLdlt;
+};
+
+struct MarginalizationResult {
+  /// Prior over `kept_blocks`; null when no variable block of the blanket
+  /// keeps any information (empty blanket, or H* numerically zero).
+  std::unique_ptr<MarginalizationPrior> prior;
+  /// The variable Markov-blanket blocks, in the prior's parameter order
+  /// (empty when `prior` is null).
+  std::vector<double*> kept_blocks;
+  /// Every residual block touching a marginalized block (folded into the
+  /// prior; removing the marginalized parameter blocks removes them).
+  std::vector<ceres::ResidualBlockId> marginalized_residual_blocks;
+};
+
+/// Computes the prior that marginalizing `to_marginalize` leaves on its Markov
+/// blanket, without changing the problem (Problem::Evaluate is not const).
+/// Duplicates in `to_marginalize` are ignored. Throws std::invalid_argument if
+/// a block is not in the problem, std::runtime_error if evaluation fails.
+MarginalizationResult ComputeMarginalization(ceres::Problem* problem,
+                                             const std::vector<double*>& to_marginalize,
+                                             const MarginalizationOptions& options = {});
+
+/// ComputeMarginalization, then removes the `to_marginalize` parameter blocks
+/// (and with them every residual block touching them) and adds the prior.
+/// Returns the prior's residual block, or nullptr when there is no prior.
+/// The problem must own its cost functions (Ceres' default
+/// Problem::Options::cost_function_ownership = TAKE_OWNERSHIP).
+ceres::ResidualBlockId MarginalizeBlocks(ceres::Problem* problem,
+                                         const std::vector<double*>& to_marginalize,
+                                         const MarginalizationOptions& options = {});
+
+}  // namespace vio::marginalization

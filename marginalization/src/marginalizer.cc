@@ -1,0 +1,234 @@
+#include "vio/marginalization/marginalizer.h"
+
+#include <algorithm>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+
+#include <Eigen/SparseCore>
+#include <ceres/crs_matrix.h>
+#include <glog/logging.h>
+
+namespace vio::marginalization {
+namespace {
+
+using BlockSet = std::unordered_set<const double*>;
+
+/// The residual blocks C2 touching the marginalized blocks and how the
+/// variable parameter blocks they touch split into kept and marginalized.
+struct MarkovBlanket {
+  /// Every residual block touching a marginalized block, in problem order.
+  std::vector<ceres::ResidualBlockId> residual_blocks;
+  /// Variable blanket blocks, in order of first appearance.
+  std::vector<double*> kept;
+  /// Variable marginalized blocks that share no residual block with one
+  /// another: eliminated block by block.
+  std::vector<double*> marg_uncoupled;
+  /// The remaining variable marginalized blocks: eliminated densely.
+  std::vector<double*> marg_dense;
+};
+
+bool IsVariable(const ceres::Problem& problem, const double* block) {
+  return !problem.IsParameterBlockConstant(block) && problem.ParameterBlockTangentSize(block) > 0;
+}
+
+std::vector<double*> UniqueBlocksInProblem(const ceres::Problem& problem,
+                                           const std::vector<double*>& blocks) {
+  std::vector<double*> unique;
+  BlockSet seen;
+  for (double* block : blocks) {
+    if (!problem.HasParameterBlock(block)) {
+      std::ostringstream message;
+      message << "marginalization: parameter block " << static_cast<const void*>(block)
+              << " is not in the problem";
+      throw std::invalid_argument(message.str());
+    }
+    if (seen.insert(block).second) {
+      unique.push_back(block);
+    }
+  }
+  return unique;
+}
+
+std::vector<ceres::ResidualBlockId> ResidualBlocksTouching(const ceres::Problem& problem,
+                                                           const std::vector<double*>& marg) {
+  std::unordered_set<ceres::ResidualBlockId> touching;
+  std::vector<ceres::ResidualBlockId> of_block;
+  for (const double* block : marg) {
+    problem.GetResidualBlocksForParameterBlock(block, &of_block);
+    touching.insert(of_block.begin(), of_block.end());
+  }
+  // Problem order, so that summation order (and the result) is reproducible.
+  std::vector<ceres::ResidualBlockId> all;
+  problem.GetResidualBlocks(&all);
+  std::vector<ceres::ResidualBlockId> ordered;
+  std::copy_if(all.begin(), all.end(), std::back_inserter(ordered),
+               [&touching](ceres::ResidualBlockId id) { return touching.count(id) > 0; });
+  return ordered;
+}
+
+/// Greedy independent set of the coupling graph (two marginalized blocks are
+/// coupled when a residual block touches both), smallest blocks first so the
+/// landmarks of a marginalized frame are eliminated one by one.
+void SplitMarginalized(const ceres::Problem& problem, const std::vector<double*>& marg_variable,
+                       const std::unordered_map<const double*, BlockSet>& coupled,
+                       MarkovBlanket* blanket) {
+  std::vector<double*> by_size = marg_variable;
+  std::stable_sort(by_size.begin(), by_size.end(), [&problem](double* a, double* b) {
+    return problem.ParameterBlockTangentSize(a) < problem.ParameterBlockTangentSize(b);
+  });
+  BlockSet picked;
+  for (double* block : by_size) {
+    const auto neighbours = coupled.find(block);
+    const bool independent =
+        neighbours == coupled.end() ||
+        std::none_of(neighbours->second.begin(), neighbours->second.end(),
+                     [&picked](const double* other) { return picked.count(other) > 0; });
+    if (independent) {
+      picked.insert(block);
+      blanket->marg_uncoupled.push_back(block);
+    } else {
+      blanket->marg_dense.push_back(block);
+    }
+  }
+}
+
+MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector<double*>& marg) {
+  MarkovBlanket blanket;
+  blanket.residual_blocks = ResidualBlocksTouching(problem, marg);
+  const BlockSet marg_set(marg.begin(), marg.end());
+  BlockSet kept_seen;
+  std::unordered_map<const double*, BlockSet> coupled;
+  std::vector<double*> touched;
+  for (const ceres::ResidualBlockId residual_block : blanket.residual_blocks) {
+    problem.GetParameterBlocksForResidualBlock(residual_block, &touched);
+    std::vector<double*> marg_here;
+    for (double* block : touched) {
+      if (!IsVariable(problem, block)) {
+        continue;
+      }
+      if (marg_set.count(block) > 0) {
+        marg_here.push_back(block);
+      } else if (kept_seen.insert(block).second) {
+        blanket.kept.push_back(block);
+      }
+    }
+    for (double* a : marg_here) {
+      for (double* b : marg_here) {
+        if (a != b) {
+          coupled[a].insert(b);
+        }
+      }
+    }
+  }
+  std::vector<double*> marg_variable;
+  std::copy_if(marg.begin(), marg.end(), std::back_inserter(marg_variable),
+               [&problem](double* block) { return IsVariable(problem, block); });
+  SplitMarginalized(problem, marg_variable, coupled, &blanket);
+  return blanket;
+}
+
+int TangentDim(const ceres::Problem& problem, const std::vector<double*>& blocks) {
+  int dim = 0;
+  for (const double* block : blocks) {
+    dim += problem.ParameterBlockTangentSize(block);
+  }
+  return dim;
+}
+
+/// H = J^T J and b = J^T r of the blanket's residual blocks, columns in the
+/// order [kept, marg_dense, marg_uncoupled], on the tangent spaces.
+NormalEquations Linearize(ceres::Problem* problem, const MarkovBlanket& blanket) {
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.residual_blocks = blanket.residual_blocks;
+  evaluate.apply_loss_function = true;
+  for (const auto* group : {&blanket.kept, &blanket.marg_dense, &blanket.marg_uncoupled}) {
+    evaluate.parameter_blocks.insert(evaluate.parameter_blocks.end(), group->begin(), group->end());
+  }
+  CHECK(!evaluate.parameter_blocks.empty()) << "an empty list would evaluate every block";
+  double cost = 0.0;
+  std::vector<double> residuals;
+  ceres::CRSMatrix jacobian;
+  if (!problem->Evaluate(evaluate, &cost, &residuals, nullptr, &jacobian)) {
+    throw std::runtime_error("marginalization: Problem::Evaluate failed on the Markov blanket");
+  }
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> J(
+      jacobian.num_rows, jacobian.num_cols, static_cast<int>(jacobian.values.size()),
+      jacobian.rows.data(), jacobian.cols.data(), jacobian.values.data());
+  const Eigen::Map<const Eigen::VectorXd> r(residuals.data(), static_cast<int>(residuals.size()));
+  const Eigen::SparseMatrix<double> JtJ = J.transpose() * J;
+  return NormalEquations{Eigen::MatrixXd(JtJ), J.transpose() * r};
+}
+
+std::vector<MarginalizationPrior::Block> PriorBlocks(const ceres::Problem& problem,
+                                                     const std::vector<double*>& kept) {
+  std::vector<MarginalizationPrior::Block> blocks;
+  for (const double* values : kept) {
+    MarginalizationPrior::Block block;
+    block.manifold = problem.GetManifold(values);
+    block.x0.assign(values, values + problem.ParameterBlockSize(values));
+    blocks.push_back(std::move(block));
+  }
+  return blocks;
+}
+
+/// Steps 2-4 of the header: linearize, Schur-complement, take the square root.
+std::unique_ptr<MarginalizationPrior> BuildPrior(ceres::Problem* problem,
+                                                 const MarkovBlanket& blanket,
+                                                 const MarginalizationOptions& options) {
+  const RankThreshold& threshold = options.rank_threshold;
+  const int keep_dim = TangentDim(*problem, blanket.kept);
+  const int dense_dim = TangentDim(*problem, blanket.marg_dense);
+  std::vector<int> uncoupled_dims;
+  for (const double* block : blanket.marg_uncoupled) {
+    uncoupled_dims.push_back(problem->ParameterBlockTangentSize(block));
+  }
+  const NormalEquations full = Linearize(problem, blanket);
+  const NormalEquations without_uncoupled = SchurComplementOfUncoupledBlocks(
+      full.H, full.b, keep_dim + dense_dim, uncoupled_dims, threshold);
+  const NormalEquations marginal =
+      SchurComplement(without_uncoupled.H, without_uncoupled.b, keep_dim, dense_dim, threshold);
+  SqrtInformation sqrt =
+      SqrtInformationFromHessian(marginal.H, marginal.b, threshold, options.sqrt_method);
+  if (sqrt.sqrt_information.rows() == 0) {
+    return nullptr;
+  }
+  return MarginalizationPrior::Create(PriorBlocks(*problem, blanket.kept),
+                                      std::move(sqrt.sqrt_information), std::move(sqrt.residual));
+}
+
+}  // namespace
+
+MarginalizationResult ComputeMarginalization(ceres::Problem* problem,
+                                             const std::vector<double*>& to_marginalize,
+                                             const MarginalizationOptions& options) {
+  CHECK(problem != nullptr);
+  const std::vector<double*> marg = UniqueBlocksInProblem(*problem, to_marginalize);
+  MarkovBlanket blanket = FindMarkovBlanket(*problem, marg);
+  MarginalizationResult result;
+  result.marginalized_residual_blocks = blanket.residual_blocks;
+  if (!blanket.kept.empty()) {
+    result.prior = BuildPrior(problem, blanket, options);
+  }
+  if (result.prior != nullptr) {
+    result.kept_blocks = std::move(blanket.kept);
+  }
+  return result;
+}
+
+ceres::ResidualBlockId MarginalizeBlocks(ceres::Problem* problem,
+                                         const std::vector<double*>& to_marginalize,
+                                         const MarginalizationOptions& options) {
+  MarginalizationResult result = ComputeMarginalization(problem, to_marginalize, options);
+  for (const double* block : UniqueBlocksInProblem(*problem, to_marginalize)) {
+    problem->RemoveParameterBlock(block);
+  }
+  if (result.prior == nullptr) {
+    return nullptr;
+  }
+  return problem->AddResidualBlock(result.prior.release(), nullptr, result.kept_blocks);
+}
+
+}  // namespace vio::marginalization

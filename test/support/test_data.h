@@ -1,0 +1,35 @@
+#pragma once
+// Where the tests find the real EuRoC data of ../shared/data.
+//
+// The folder comes from $VIO_DATA_DIR, else `../shared/data` relative to the
+// project root. Tests that need it call VIO_REQUIRE_DATA(path), which skips the
+// test with a message that names the missing folder: a user's clone has no
+// ../shared, CI has it.
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace vio::test {
+
+/// The real-data root ($VIO_DATA_DIR or <project>/../shared/data).
+std::string DataDir();
+
+/// <DataDir()>/euroc/<name>: an ASL sequence folder (the one holding mav0/).
+std::string EurocSequence(const std::string& name);
+
+/// True when `path` exists.
+bool PathExists(const std::string& path);
+
+/// A fresh, empty temporary folder for one test (removed at exit is not
+/// guaranteed; it lives under the system temp dir).
+std::string MakeTempDir(const std::string& prefix);
+
+}  // namespace vio::test
+
+#define VIO_REQUIRE_DATA(path)                                                 \
+  do {                                                                         \
+    if (!::vio::test::PathExists(path)) {                                      \
+      GTEST_SKIP() << "real data not found at " << (path)                      \
+                   << " (set VIO_DATA_DIR to the folder holding euroc/)";     \
+    }                                                                          \
+  } while (0)

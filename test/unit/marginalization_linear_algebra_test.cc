@@ -1,0 +1,219 @@
+// Dense marginalization algebra against closed forms: the Schur complement is
+// the inverse of the kept block of the covariance and keeps the kept part of
+// the minimizer; the square root reproduces (H, b).
+#include "vio/marginalization/linear_algebra.h"
+
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <gtest/gtest.h>
+
+namespace vio::marginalization {
+namespace {
+
+double RelativeError(const Eigen::MatrixXd& actual, const Eigen::MatrixXd& expected) {
+  return (actual - expected).norm() / expected.norm();
+}
+
+Eigen::MatrixXd RandomMatrix(int rows, int cols, std::mt19937* rng) {
+  std::normal_distribution<double> normal;
+  return Eigen::MatrixXd::NullaryExpr(rows, cols, [&] { return normal(*rng); });
+}
+
+// H = J^T J and b = J^T r of a random over-determined linear cost.
+NormalEquations RandomNormalEquations(int rows, int dim, std::mt19937* rng) {
+  const Eigen::MatrixXd J = RandomMatrix(rows, dim, rng);
+  const Eigen::VectorXd r = RandomMatrix(rows, 1, rng);
+  return {J.transpose() * J, J.transpose() * r};
+}
+
+TEST(SchurComplement, EqualsInverseOfMarginalCovarianceAndKeepsTheMinimizer) {
+  std::mt19937 rng(1);
+  const int keep = 4, marg = 5;
+  const NormalEquations full = RandomNormalEquations(20, keep + marg, &rng);
+  const NormalEquations marginal = SchurComplement(full.H, full.b, keep, marg);
+
+  const Eigen::MatrixXd covariance = full.H.inverse();
+  const Eigen::MatrixXd expected_information = covariance.topLeftCorner(keep, keep).inverse();
+  EXPECT_LT(RelativeError(marginal.H, expected_information), 1e-10);
+
+  // argmin of dx^T H dx + 2 b^T dx is -H^-1 b; its kept part is the marginal's argmin.
+  const Eigen::VectorXd full_minimizer = -full.H.ldlt().solve(full.b);
+  const Eigen::VectorXd marginal_minimizer = -marginal.H.ldlt().solve(marginal.b);
+  EXPECT_LT(RelativeError(marginal_minimizer, full_minimizer.head(keep)), 1e-10);
+}
+
+TEST(SchurComplement, NothingToMarginalizeReturnsTheInput) {
+  std::mt19937 rng(2);
+  const NormalEquations full = RandomNormalEquations(8, 3, &rng);
+  const NormalEquations marginal = SchurComplement(full.H, full.b, 3, 0);
+  EXPECT_LT(RelativeError(marginal.H, full.H), 1e-15);
+  EXPECT_LT(RelativeError(marginal.b, full.b), 1e-15);
+}
+
+TEST(SchurComplement, UnconstrainedMarginalizedDirectionIsDropped) {
+  // The last variable appears in no residual: H_MM is singular. The
+  // pseudo-inverse must give the same marginal as if it did not exist.
+  std::mt19937 rng(3);
+  const int keep = 3, marg = 3;
+  NormalEquations with_free = RandomNormalEquations(12, keep + marg, &rng);
+  with_free.H.row(keep + marg - 1).setZero();
+  with_free.H.col(keep + marg - 1).setZero();
+  with_free.b(keep + marg - 1) = 0.0;
+  const NormalEquations expected =
+      SchurComplement(with_free.H.topLeftCorner(5, 5), with_free.b.head(5), keep, 2);
+  const NormalEquations actual = SchurComplement(with_free.H, with_free.b, keep, marg);
+  EXPECT_LT(RelativeError(actual.H, expected.H), 1e-10);
+  EXPECT_LT(RelativeError(actual.b, expected.b), 1e-10);
+}
+
+TEST(SchurComplement, RejectsInconsistentSizes) {
+  const Eigen::MatrixXd H = Eigen::MatrixXd::Identity(4, 4);
+  const Eigen::VectorXd b = Eigen::VectorXd::Zero(4);
+  EXPECT_THROW(SchurComplement(H, b, 2, 1), std::invalid_argument);
+  EXPECT_THROW(SchurComplement(H, Eigen::VectorXd::Zero(3), 2, 2), std::invalid_argument);
+  Eigen::MatrixXd not_finite = H;
+  not_finite(1, 1) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(SchurComplement(not_finite, b, 2, 2), std::invalid_argument);
+}
+
+// Frames (kept, size 6) observe landmarks (marginalized, size 3): no residual
+// touches two landmarks, so H_MM is block-diagonal.
+TEST(SchurComplementOfUncoupledBlocks, MatchesTheDenseSchurComplement) {
+  std::mt19937 rng(4);
+  const int keep = 12;
+  const std::vector<int> landmark_dims = {3, 3, 2, 3};
+  const int dim = keep + 11;
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(0, dim);
+  int offset = keep;
+  for (const int landmark_dim : landmark_dims) {
+    for (int frame = 0; frame < 2; ++frame) {
+      Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(2, dim);
+      rows.middleCols(6 * frame, 6) = RandomMatrix(2, 6, &rng);
+      rows.middleCols(offset, landmark_dim) = RandomMatrix(2, landmark_dim, &rng);
+      J.conservativeResize(J.rows() + 2, Eigen::NoChange);
+      J.bottomRows(2) = rows;
+    }
+    offset += landmark_dim;
+  }
+  J.conservativeResize(J.rows() + keep, Eigen::NoChange);
+  J.bottomRows(keep) << RandomMatrix(keep, keep, &rng), Eigen::MatrixXd::Zero(keep, dim - keep);
+  const Eigen::VectorXd r = RandomMatrix(static_cast<int>(J.rows()), 1, &rng);
+  const Eigen::MatrixXd H = J.transpose() * J;
+  const Eigen::VectorXd b = J.transpose() * r;
+
+  const NormalEquations dense = SchurComplement(H, b, keep, dim - keep);
+  const NormalEquations blockwise = SchurComplementOfUncoupledBlocks(H, b, keep, landmark_dims);
+  EXPECT_LT(RelativeError(blockwise.H, dense.H), 1e-10);
+  EXPECT_LT(RelativeError(blockwise.b, dense.b), 1e-10);
+}
+
+TEST(SchurComplementOfUncoupledBlocks, RejectsCoupledBlocks) {
+  std::mt19937 rng(5);
+  const NormalEquations full = RandomNormalEquations(12, 6, &rng);  // dense: all coupled
+  EXPECT_THROW(SchurComplementOfUncoupledBlocks(full.H, full.b, 2, {2, 2}), std::invalid_argument);
+  EXPECT_THROW(SchurComplementOfUncoupledBlocks(full.H, full.b, 2, {2, 3}), std::invalid_argument);
+}
+
+TEST(PseudoInverse, SatisfiesThePenroseConditionsOnARankDeficientMatrix) {
+  std::mt19937 rng(6);
+  const Eigen::MatrixXd J = RandomMatrix(3, 6, &rng);  // rank 3 in R^6
+  const Eigen::MatrixXd H = J.transpose() * J;
+  const Eigen::MatrixXd H_pinv = PseudoInverse(H);
+  EXPECT_LT(RelativeError(H * H_pinv * H, H), 1e-10);
+  EXPECT_LT(RelativeError(H_pinv * H * H_pinv, H_pinv), 1e-10);
+}
+
+class SqrtInformationFromHessianTest : public ::testing::TestWithParam<SqrtMethod> {};
+
+TEST_P(SqrtInformationFromHessianTest, ReproducesFullRankInformationAndVector) {
+  std::mt19937 rng(7);
+  const NormalEquations eq = RandomNormalEquations(15, 7, &rng);
+  const SqrtInformation prior = SqrtInformationFromHessian(eq.H, eq.b, {}, GetParam());
+  ASSERT_EQ(prior.sqrt_information.rows(), 7);
+  const Eigen::MatrixXd& Jp = prior.sqrt_information;
+  EXPECT_LT(RelativeError(Jp.transpose() * Jp, eq.H), 1e-12);
+  EXPECT_LT(RelativeError(Jp.transpose() * prior.residual, eq.b), 1e-12);
+}
+
+TEST_P(SqrtInformationFromHessianTest, DropsTheNullSpaceOfRankDeficientInformation) {
+  std::mt19937 rng(8);
+  const Eigen::MatrixXd J = RandomMatrix(2, 5, &rng);  // rank 2
+  const Eigen::VectorXd r = RandomMatrix(2, 1, &rng);
+  const Eigen::MatrixXd H = J.transpose() * J;
+  const Eigen::VectorXd b = J.transpose() * r;  // in the range of H
+  const SqrtInformation prior = SqrtInformationFromHessian(H, b, {}, GetParam());
+  ASSERT_EQ(prior.sqrt_information.rows(), 2);
+  const Eigen::MatrixXd& Jp = prior.sqrt_information;
+  EXPECT_LT(RelativeError(Jp.transpose() * Jp, H), 1e-12);
+  EXPECT_LT(RelativeError(Jp.transpose() * prior.residual, b), 1e-12);
+  // Same cost up to a constant: |r0 + Jp dx|^2 - |r + J dx|^2 does not depend on dx.
+  const Eigen::VectorXd dx = RandomMatrix(5, 1, &rng);
+  const double difference_at_dx =
+      (prior.residual + Jp * dx).squaredNorm() - (r + J * dx).squaredNorm();
+  const double difference_at_0 = prior.residual.squaredNorm() - r.squaredNorm();
+  EXPECT_NEAR(difference_at_dx, difference_at_0, 1e-10);
+}
+
+TEST_P(SqrtInformationFromHessianTest, GaugeFreedomOfAWindowIsDropped) {
+  // 40 variables observed only through differences x_i - x_j: the common
+  // offset (1, ..., 1) is unobservable, like the position of a VIO window.
+  std::mt19937 rng(9);
+  std::uniform_int_distribution<int> pick(0, 39);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(120, 40);
+  for (int row = 0; row < 120; ++row) {
+    const int i = row % 40;
+    const int j = (i + 1 + pick(rng) % 39) % 40;
+    J(row, i) = 1.0 + 0.1 * (row % 7);
+    J(row, j) = -J(row, i);
+  }
+  const Eigen::VectorXd r = RandomMatrix(120, 1, &rng);
+  const Eigen::MatrixXd H = J.transpose() * J;
+  const Eigen::VectorXd b = J.transpose() * r;
+  const SqrtInformation prior = SqrtInformationFromHessian(H, b, {}, GetParam());
+  ASSERT_EQ(prior.sqrt_information.rows(), 39);
+  const Eigen::MatrixXd& Jp = prior.sqrt_information;
+  EXPECT_LT(RelativeError(Jp.transpose() * Jp, H), 1e-12);
+  EXPECT_LT(RelativeError(Jp.transpose() * prior.residual, b), 1e-12);
+  EXPECT_LT((Jp * Eigen::VectorXd::Ones(40)).norm(), 1e-10 * Jp.norm());
+}
+
+TEST_P(SqrtInformationFromHessianTest, ZeroInformationGivesNoRows) {
+  const SqrtInformation prior = SqrtInformationFromHessian(
+      Eigen::MatrixXd::Zero(4, 4), Eigen::VectorXd::Zero(4), {}, GetParam());
+  EXPECT_EQ(prior.sqrt_information.rows(), 0);
+  EXPECT_EQ(prior.sqrt_information.cols(), 4);
+  EXPECT_EQ(prior.residual.size(), 0);
+}
+
+TEST_P(SqrtInformationFromHessianTest, ThresholdsDropSmallEigenvalues) {
+  const Eigen::Vector3d lambda(1e6, 1.0, 1e-5);
+  const Eigen::MatrixXd H = lambda.asDiagonal();
+  const Eigen::VectorXd b = Eigen::Vector3d(1.0, 1.0, 0.0);
+  RankThreshold threshold;
+  EXPECT_EQ(SqrtInformationFromHessian(H, b, threshold, GetParam()).sqrt_information.rows(),
+            3);  // cutoff 1e-6
+  threshold.absolute = 1e-4;
+  EXPECT_EQ(SqrtInformationFromHessian(H, b, threshold, GetParam()).sqrt_information.rows(), 2);
+  threshold.relative = 1e-3;  // cutoff 1e3
+  EXPECT_EQ(SqrtInformationFromHessian(H, b, threshold, GetParam()).sqrt_information.rows(), 1);
+}
+
+TEST_P(SqrtInformationFromHessianTest, RejectsNonSquareInput) {
+  EXPECT_THROW(SqrtInformationFromHessian(Eigen::MatrixXd::Zero(3, 2), Eigen::VectorXd::Zero(3), {},
+                                          GetParam()),
+               std::invalid_argument);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothMethods, SqrtInformationFromHessianTest,
+                         ::testing::Values(SqrtMethod::kEigen, SqrtMethod::kPivotedLdlt),
+                         [](const ::testing::TestParamInfo<SqrtMethod>& info) {
+                           return info.param == SqrtMethod::kEigen ? "Eigen" : "PivotedLdlt";
+                         });
+
+}  // namespace
+}  // namespace vio::marginalization

@@ -1,0 +1,138 @@
+#include "vio/tools/run.h"
+
+#include <sys/resource.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include <glog/logging.h>
+
+#include "run_output.h"
+#include "vio/estimator/estimator.h"
+#include "vio/frontend/stereo_rectifier.h"
+#include "vio/tools/euroc_dataset.h"
+#include "vio/tools/progress.h"
+#include "vio/tools/stereo_frames.h"
+
+namespace vio::tools {
+namespace {
+
+// The dataset's calibration, or the one of the folder the config names.
+void ApplyCalibrationSource(const CalibrationOptions& options, EurocDataset* dataset) {
+  if (options.calibration.empty()) return;
+  EurocReadOptions calibration_only;
+  calibration_only.read_imu = calibration_only.read_groundtruth = calibration_only.read_features = false;
+  calibration_only.check_images = false;
+  const EurocDataset calibration = ReadEuroc(options.calibration, calibration_only);
+  dataset->cameras[0] = calibration.cameras[0];
+  dataset->cameras[1] = calibration.cameras[1];
+  dataset->imu_calibration = calibration.imu_calibration;
+}
+
+EurocDataset ReadRunDataset(const RunRequest& request) {
+  EurocReadOptions read;
+  read.check_images = false;  // the features front end reads no images
+  EurocDataset dataset = ReadEuroc(request.dataset_dir, read);
+  ApplyCalibrationSource(request.config.calibration, &dataset);
+  if (dataset.features.empty()) {
+    throw std::runtime_error(request.dataset_dir + ": no mav0/features0/data.csv: the 'features' front end needs it "
+                             "(generate one with `vio simulate --from=" + request.dataset_dir + "`)");
+  }
+  return dataset;
+}
+
+// Ground truth at t_ns (linear in position, velocity and biases; slerp in
+// rotation), or nothing outside its span.
+std::optional<InitialState> GroundTruthAt(const std::vector<GroundTruthState>& gt, Timestamp t_ns) {
+  auto it = std::lower_bound(gt.begin(), gt.end(), t_ns,
+                             [](const GroundTruthState& s, Timestamp t) { return s.t_ns < t; });
+  if (it == gt.end() || (it == gt.begin() && it->t_ns != t_ns)) return std::nullopt;
+  const GroundTruthState& b = *it;
+  const GroundTruthState& a = it == gt.begin() ? b : *(it - 1);
+  const double s = b.t_ns == a.t_ns ? 0.0 : static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
+  InitialState state;
+  state.t_ns = t_ns;
+  state.p_w_b = (1 - s) * a.p_w_b + s * b.p_w_b;
+  state.q_w_b = a.q_w_b.slerp(s, b.q_w_b);
+  state.v_w_b = (1 - s) * a.v_w_b + s * b.v_w_b;
+  state.gyro_bias = (1 - s) * a.gyro_bias + s * b.gyro_bias;
+  state.accel_bias = (1 - s) * a.accel_bias + s * b.accel_bias;
+  return state;
+}
+
+bool Diverged(const FrameEstimate& e) {
+  return !e.p_w_b.allFinite() || !e.q_w_b.coeffs().allFinite() || e.p_w_b.norm() > 1e4 || e.v_w_b.norm() > 100;
+}
+
+double PeakMemoryMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+}  // namespace
+
+RunResult RunDataset(const RunRequest& request) {
+  const EurocDataset dataset = ReadRunDataset(request);
+  const frontend::StereoRectifier rectifier(dataset.cameras[0], dataset.cameras[1]);
+  StereoFramesReport frames_report;
+  const std::vector<StereoFrame> frames = StereoFramesFromFeatures(
+      dataset.features, dataset.frames[0], rectifier, request.config.frontend.max_epipolar_px, &frames_report);
+  const EstimatorOptions& options = request.config.estimator;
+  Estimator estimator(options, dataset.imu_calibration, rectifier.rectified());
+
+  RunResult result;
+  result.frames = static_cast<int>(frames.size());
+  if (!frames.empty()) result.dataset_duration_s = NanosToSeconds(frames.back().t_ns - frames.front().t_ns);
+  RunOutput output(request.output_dir);
+  const auto num_frames = static_cast<std::int64_t>(frames.size());
+  ProgressBar progress = request.show_progress ? ProgressBar(num_frames, "frames")
+                                               : ProgressBar(num_frames, "frames", nullptr, false);
+  const bool init_from_gt = options.init.init == "groundtruth";
+  if (init_from_gt && dataset.groundtruth.empty()) {
+    throw std::runtime_error(request.dataset_dir + ": --init=groundtruth but the dataset has no ground truth");
+  }
+  size_t next_imu = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (size_t k = 0; k < frames.size(); ++k) {
+    const StereoFrame& frame = frames[k];
+    // IMU up to and including the first sample at or after the frame.
+    while (next_imu < dataset.imu.size() && (next_imu == 0 || dataset.imu[next_imu - 1].t_ns < frame.t_ns)) {
+      estimator.AddImu(dataset.imu[next_imu++]);
+    }
+    if (next_imu == 0 || dataset.imu[next_imu - 1].t_ns < frame.t_ns) break;  // IMU ends before the frame
+    if (init_from_gt && result.frames_estimated == 0) {
+      const std::optional<InitialState> gt = GroundTruthAt(dataset.groundtruth, frame.t_ns);
+      if (!gt) continue;  // frame before the ground-truth span: no state to start from
+      estimator.SetInitialState(*gt);
+    }
+    const FrameEstimate estimate = estimator.ProcessFrame(frame);
+    progress.Update(static_cast<std::int64_t>(k + 1));
+    if (!estimate.initialized) continue;
+    if (Diverged(estimate)) {
+      result.status = "diverged";
+      LOG(ERROR) << "estimate diverged at t=" << NanosToSeconds(frame.t_ns) << " s (frame " << k << ")";
+      break;
+    }
+    output.AddFrame(estimate);
+    ++result.frames_estimated;
+  }
+  result.processing_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  progress.Finish();
+  if (result.frames_estimated == 0 && result.status == "ok") result.status = "not_initialized";
+  result.ms_per_frame = result.frames_estimated ? 1e3 * result.processing_s / result.frames_estimated : 0.0;
+  result.real_time_factor = result.processing_s > 0 ? result.dataset_duration_s / result.processing_s : 0.0;
+  if (!dataset.groundtruth.empty() && result.frames_estimated >= 3) {
+    result.evaluation = EvaluateTrajectory(output.trajectory(), dataset.groundtruth);
+  }
+  output.WriteTrajectory();
+  output.WriteTiming();
+  output.WriteSummary(result, frames_report, request, PeakMemoryMb(), estimator.waiting_reason());
+  output.WriteConfig(RunConfigToYaml(request.config));
+  return result;
+}
+
+}  // namespace vio::tools

@@ -1,0 +1,123 @@
+#include "run_output.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+namespace vio::tools {
+namespace {
+
+std::ofstream OpenForWriting(const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot open for writing");
+  return out;
+}
+
+std::string Number(double value) {
+  if (!std::isfinite(value)) return "null";
+  std::ostringstream os;
+  os << std::setprecision(8) << value;
+  return os.str();
+}
+
+// Mean over frames of one stage time.
+template <class Get>
+double MeanMs(const std::vector<FrameEstimate>& frames, Get get) {
+  if (frames.empty()) return 0.0;
+  double sum = 0;
+  for (const FrameEstimate& f : frames) sum += get(f);
+  return sum / static_cast<double>(frames.size());
+}
+
+std::string StageTimesJson(const std::vector<FrameEstimate>& f) {
+  std::ostringstream os;
+  os << "{\"propagate\": " << Number(MeanMs(f, [](auto& e) { return e.timing.propagate_ms; }))
+     << ", \"build\": " << Number(MeanMs(f, [](auto& e) { return e.timing.policy.build_ms; }))
+     << ", \"solve\": " << Number(MeanMs(f, [](auto& e) { return e.timing.policy.solve_ms; }))
+     << ", \"marginalize\": " << Number(MeanMs(f, [](auto& e) { return e.timing.policy.marginalize_ms; }))
+     << ", \"total\": " << Number(MeanMs(f, [](auto& e) { return e.timing.total_ms; })) << "}";
+  return os.str();
+}
+
+std::string FramesReportJson(const StereoFramesReport& r) {
+  std::ostringstream os;
+  os << "{\"frames\": " << r.frames << ", \"stereo_observations\": " << r.stereo_observations
+     << ", \"left_only\": " << r.left_only << ", \"right_only\": " << r.right_only
+     << ", \"rejected_epipolar\": " << r.rejected_epipolar << ", \"rejected_disparity\": " << r.rejected_disparity
+     << ", \"unrectifiable\": " << r.unrectifiable << ", \"observations_off_frames\": " << r.observations_off_frames
+     << "}";
+  return os.str();
+}
+
+std::string JsonString(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+RunOutput::RunOutput(std::string dir) : dir_(std::move(dir)) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir_, ec);
+  if (ec) throw std::runtime_error(dir_ + ": cannot create output folder: " + ec.message());
+}
+
+void RunOutput::AddFrame(const FrameEstimate& estimate) {
+  GroundTruthState pose;
+  pose.t_ns = estimate.t_ns;
+  pose.p_w_b = estimate.p_w_b;
+  pose.q_w_b = estimate.q_w_b;
+  pose.v_w_b = estimate.v_w_b;
+  pose.gyro_bias = estimate.gyro_bias;
+  pose.accel_bias = estimate.accel_bias;
+  trajectory_.push_back(pose);
+  frames_.push_back(estimate);
+}
+
+void RunOutput::WriteTrajectory() const { WriteTumTrajectory(trajectory_, dir_ + "/trajectory.txt"); }
+
+void RunOutput::WriteTiming() const {
+  std::ofstream out = OpenForWriting(dir_ + "/timing.csv");
+  out << "#timestamp [ns],propagate [ms],build [ms],solve [ms],marginalize [ms],total [ms],"
+         "solver_iterations,states,landmarks,observations\n";
+  for (const FrameEstimate& f : frames_) {
+    const PolicyTiming& p = f.timing.policy;
+    out << f.t_ns << "," << Number(f.timing.propagate_ms) << "," << Number(p.build_ms) << ","
+        << Number(p.solve_ms) << "," << Number(p.marginalize_ms) << "," << Number(f.timing.total_ms) << ","
+        << p.solver_iterations << "," << f.num_states << "," << f.num_landmarks << "," << f.num_observations
+        << "\n";
+  }
+}
+
+void RunOutput::WriteSummary(const RunResult& r, const StereoFramesReport& frames, const RunRequest& request,
+                             double peak_memory_mb, const std::string& waiting_reason) const {
+  std::ofstream out = OpenForWriting(dir_ + "/summary.json");
+  const PolicyOptions& policy = request.config.estimator.policy;
+  out << "{\n  \"dataset\": " << JsonString(request.dataset_dir) << ",\n  \"policy\": " << JsonString(policy.policy)
+      << ",\n  \"window_size\": " << policy.window_size << ",\n  \"status\": " << JsonString(r.status)
+      << ",\n  \"frames\": " << r.frames << ",\n  \"frames_estimated\": " << r.frames_estimated
+      << ",\n  \"dataset_duration_s\": " << Number(r.dataset_duration_s)
+      << ",\n  \"processing_s\": " << Number(r.processing_s) << ",\n  \"ms_per_frame\": " << Number(r.ms_per_frame)
+      << ",\n  \"real_time_factor\": " << Number(r.real_time_factor)
+      << ",\n  \"stage_ms_per_frame\": " << StageTimesJson(frames_)
+      << ",\n  \"peak_memory_mb\": " << Number(peak_memory_mb) << ",\n  \"frontend\": " << FramesReportJson(frames);
+  if (!waiting_reason.empty()) out << ",\n  \"not_initialized_reason\": " << JsonString(waiting_reason);
+  if (r.evaluation) {
+    std::string evaluation = ToJson(*r.evaluation);
+    for (size_t pos = 0; (pos = evaluation.find('\n', pos)) != std::string::npos; pos += 3) {
+      evaluation.replace(pos, 1, "\n  ");
+    }
+    out << ",\n  \"evaluation\": " << evaluation;
+  }
+  out << "\n}\n";
+}
+
+void RunOutput::WriteConfig(const std::string& yaml) const { OpenForWriting(dir_ + "/config.yaml") << yaml; }
+
+}  // namespace vio::tools

@@ -1,0 +1,34 @@
+#pragma once
+// The files of one run's output folder (see run.h). Private to tools.
+#include <string>
+#include <vector>
+
+#include "vio/estimator/estimator.h"
+#include "vio/tools/euroc_dataset.h"
+#include "vio/tools/run.h"
+#include "vio/tools/stereo_frames.h"
+
+namespace vio::tools {
+
+class RunOutput {
+ public:
+  /// Creates `dir`; throws std::runtime_error when it cannot.
+  explicit RunOutput(std::string dir);
+
+  void AddFrame(const FrameEstimate& estimate);
+  /// The estimated poses so far (t, p_w_b, q_w_b).
+  const std::vector<GroundTruthState>& trajectory() const { return trajectory_; }
+
+  void WriteTrajectory() const;
+  void WriteTiming() const;
+  void WriteSummary(const RunResult& result, const StereoFramesReport& frames, const RunRequest& request,
+                    double peak_memory_mb, const std::string& waiting_reason) const;
+  void WriteConfig(const std::string& yaml) const;
+
+ private:
+  std::string dir_;
+  std::vector<GroundTruthState> trajectory_;
+  std::vector<FrameEstimate> frames_;
+};
+
+}  // namespace vio::tools
