@@ -122,9 +122,31 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
   it->second.observed_from.insert(state_id);
 }
 
+// Landmarks (group 0) are eliminated first by the Schur complement; the
+// state blocks follow, one group each in id order, so that the reduced system
+// is laid out by the window's ids rather than by addresses (Ceres orders the
+// blocks inside one group by address). Landmarks tied together by a prior are
+// not an independent set: they join the states, after them.
+std::shared_ptr<ceres::ParameterBlockOrdering> Window::SchurOrdering() const {
+  std::set<const double*> in_prior;
+  for (const Prior& prior : priors_) in_prior.insert(prior.blocks.begin(), prior.blocks.end());
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  int group = 1;
+  for (const auto& [id, s] : states_) {
+    ordering->AddElementToGroup(const_cast<double*>(s.pose), group++);
+    ordering->AddElementToGroup(const_cast<double*>(s.speed_bias), group++);
+  }
+  for (const auto& [id, landmark] : landmarks_) {
+    const bool eliminated = in_prior.count(landmark.p_w) == 0;
+    ordering->AddElementToGroup(const_cast<double*>(landmark.p_w), eliminated ? 0 : group++);
+  }
+  return ordering;
+}
+
 SolveReport Window::Solve(const SolverOptions& options) {
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_SCHUR;
+  solver.linear_solver_ordering = SchurOrdering();
   solver.max_num_iterations = options.max_iterations;
   solver.max_solver_time_in_seconds = options.max_solver_time_s;
   solver.function_tolerance = options.function_tolerance;

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include <glog/logging.h>
 
@@ -12,12 +14,12 @@
 namespace vio::tools {
 namespace {
 
-constexpr int kTileSize = 16;  // [px]
 constexpr std::array<float, 4> kCellSizes = {0.8f, 0.3f, 0.12f, 0.05f};  // [m], coarse to fine
 constexpr std::array<float, 4> kInverseCellSizes = {1.0f / 0.8f, 1.0f / 0.3f, 1.0f / 0.12f, 1.0f / 0.05f};
 // Of 8 cells of each level, this many hold a rectangle.
 constexpr std::array<std::uint64_t, 4> kRectangleEighths = {6, 4, 3, 2};
-constexpr float kCellOffset = 4096.0f;  // keeps cell coordinates positive (rooms < 200 m)
+constexpr float kCellOffset = 4096.0f;  // keeps cell coordinates positive ...
+constexpr double kMaxCoordinate = 150.0;  // ... for rooms within this distance of the origin [m]
 constexpr float kMinCellPixels = 3.0f;  // finer texture levels are skipped (anti-aliasing)
 
 // splitmix64 finalizer: a fast, well-mixed 64-bit hash.
@@ -42,11 +44,45 @@ struct SurfaceHit {
   int axis = 0;  // normal axis of the hit face
 };
 
+// The nearest of: the room face the ray leaves through, the listed boxes
+// (slab test). `d` has no zero component.
+inline SurfaceHit CastRay(const Eigen::Vector3f& room_min, const Eigen::Vector3f& room_max,
+                          const std::vector<Eigen::AlignedBox3f>& all_boxes, const int* boxes, int num_boxes,
+                          const Eigen::Vector3f& p_w_c, const Eigen::Vector3f& d) {
+  const Eigen::Vector3f inv = d.cwiseInverse();
+  SurfaceHit hit;
+  for (int a = 0; a < 3; ++a) {
+    const bool positive = d[a] > 0.0f;
+    const float t = ((positive ? room_max[a] : room_min[a]) - p_w_c[a]) * inv[a];
+    if (t < hit.t) hit = {t, 2 * a + (positive ? 1 : 0), a};
+  }
+  for (int k = 0; k < num_boxes; ++k) {
+    const Eigen::AlignedBox3f& box = all_boxes[boxes[k]];
+    const Eigen::Vector3f t1 = (box.min() - p_w_c).cwiseProduct(inv);
+    const Eigen::Vector3f t2 = (box.max() - p_w_c).cwiseProduct(inv);
+    int axis = 0;
+    const float t_enter = t1.cwiseMin(t2).maxCoeff(&axis);
+    const float t_exit = t1.cwiseMax(t2).minCoeff();
+    if (t_enter <= t_exit && t_enter > 0.0f && t_enter < hit.t) {
+      hit = {t_enter, 6 + 6 * boxes[k] + 2 * axis + (inv[axis] > 0.0f ? 0 : 1), axis};
+    }
+  }
+  return hit;
+}
+
 }  // namespace
 
 SceneRenderer::SceneRenderer(const Scene& scene, const CameraCalibration& camera,
                              const RenderOptions& options)
-    : scene_(scene), camera_(camera), options_(options) {
+    : scene_(scene),
+      camera_(camera),
+      options_(options),
+      room_min_(scene.room.min().cast<float>()),
+      room_max_(scene.room.max().cast<float>()) {
+  if (!(scene.room.min().cwiseAbs().maxCoeff() < kMaxCoordinate && scene.room.max().cwiseAbs().maxCoeff() < kMaxCoordinate)) {
+    throw std::invalid_argument("renderer: the room must lie within " + std::to_string(kMaxCoordinate) +
+                                " m of the world origin (texture cell coordinates)");
+  }
   for (const Eigen::AlignedBox3d& box : scene.boxes) boxes_.emplace_back(box.cast<float>());
   BuildRayTable();
   BuildTextures();
@@ -65,22 +101,15 @@ void SceneRenderer::BuildRayTable() {
   tiles_x_ = (width + kTileSize - 1) / kTileSize;
   tiles_y_ = (height + kTileSize - 1) / kTileSize;
   tiles_.assign(tiles_x_ * tiles_y_, Tile());
-  for (int ty = 0; ty < tiles_y_; ++ty) {
-    for (int tx = 0; tx < tiles_x_; ++tx) {
-      Tile& tile = tiles_[ty * tiles_x_ + tx];
-      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-      for (int v = ty * kTileSize; v < std::min(height, (ty + 1) * kTileSize); ++v) {
-        for (int u = tx * kTileSize; u < std::min(width, (tx + 1) * kTileSize); ++u) sum += rays_c_[v * width + u];
-      }
-      tile.axis_c = sum.normalized();
-      float min_cos = 1.0f;
-      for (int v = ty * kTileSize; v < std::min(height, (ty + 1) * kTileSize); ++v) {
-        for (int u = tx * kTileSize; u < std::min(width, (tx + 1) * kTileSize); ++u) {
-          min_cos = std::min(min_cos, tile.axis_c.dot(rays_c_[v * width + u]));
-        }
-      }
-      tile.half_angle = std::acos(std::clamp(min_cos, -1.0f, 1.0f)) + 1e-3f;
-    }
+  for (std::size_t t = 0; t < tiles_.size(); ++t) {
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+    ForEachPixel(static_cast<int>(t), [&](int, int, std::size_t index) { sum += rays_c_[index]; });
+    tiles_[t].axis_c = sum.normalized();
+    float min_cos = 1.0f;
+    ForEachPixel(static_cast<int>(t), [&](int, int, std::size_t index) {
+      if (!rays_c_[index].isZero()) min_cos = std::min(min_cos, tiles_[t].axis_c.dot(rays_c_[index]));
+    });
+    tiles_[t].half_angle = std::acos(std::clamp(min_cos, -1.0f, 1.0f)) + 1e-3f;
   }
 }
 
@@ -160,51 +189,27 @@ void SceneRenderer::Render(const Eigen::Isometry3d& T_w_c, std::uint64_t noise_k
 
 void SceneRenderer::RenderTile(int tile, const Eigen::Matrix3f& R_w_c, const Eigen::Vector3f& p_w_c,
                                const int* boxes, int num_boxes, std::uint64_t noise_key, cv::Mat* image) const {
-  const int width = camera_.width, height = camera_.height;
-  const int tx = tile % tiles_x_, ty = tile / tiles_x_;
-  const Eigen::Vector3f room_min = scene_.room.min().cast<float>(), room_max = scene_.room.max().cast<float>();
   const float focal = static_cast<float>(camera_.intrinsics[0]);
   const float noise_sigma = static_cast<float>(options_.image_noise_sigma);
-  for (int v = ty * kTileSize; v < std::min(height, (ty + 1) * kTileSize); ++v) {
-    std::uint8_t* row = image->ptr<std::uint8_t>(v);
-    for (int u = tx * kTileSize; u < std::min(width, (tx + 1) * kTileSize); ++u) {
-      const std::size_t index = static_cast<std::size_t>(v) * width + u;
-      const Eigen::Vector3f& ray_c = rays_c_[index];
-      if (ray_c.isZero()) {
-        row[u] = 0;
-        continue;
-      }
-      Eigen::Vector3f d = R_w_c * ray_c;
-      for (int a = 0; a < 3; ++a) {
-        if (std::abs(d[a]) < 1e-9f) d[a] = 1e-9f;
-      }
-      const Eigen::Vector3f inv = d.cwiseInverse();
-      SurfaceHit hit;
-      for (int a = 0; a < 3; ++a) {  // leaving the convex room
-        const bool positive = d[a] > 0.0f;
-        const float t = ((positive ? room_max[a] : room_min[a]) - p_w_c[a]) * inv[a];
-        if (t < hit.t) hit = {t, 2 * a + (positive ? 1 : 0), a};
-      }
-      for (int k = 0; k < num_boxes; ++k) {  // slab test
-        const Eigen::AlignedBox3f& box = boxes_[boxes[k]];
-        const Eigen::Vector3f t1 = (box.min() - p_w_c).cwiseProduct(inv);
-        const Eigen::Vector3f t2 = (box.max() - p_w_c).cwiseProduct(inv);
-        const Eigen::Vector3f t_in = t1.cwiseMin(t2);
-        int axis = 0;
-        const float t_enter = t_in.maxCoeff(&axis);
-        const float t_exit = t1.cwiseMax(t2).minCoeff();
-        if (t_enter <= t_exit && t_enter > 0.0f && t_enter < hit.t) {
-          hit = {t_enter, 6 + 6 * boxes[k] + 2 * axis + (inv[axis] > 0.0f ? 0 : 1), axis};
-        }
-      }
-      const Eigen::Vector3f p = p_w_c + hit.t * d;
-      const int a1 = (hit.axis + 1) % 3, a2 = (hit.axis + 2) % 3;
-      const float footprint = hit.t / (focal * std::max(std::abs(d[hit.axis]), 0.2f));
-      float grey = SurfaceGrey(hit.surface, p[a1], p[a2], footprint);
-      if (noise_sigma > 0.0f) grey += noise_sigma * HashNormal(Mix(noise_key * 0x2545f4914f6cdd1dULL + index));
-      row[u] = static_cast<std::uint8_t>(std::clamp(grey + 0.5f, 0.0f, 255.0f));
+  ForEachPixel(tile, [&](int u, int v, std::size_t index) {
+    std::uint8_t& pixel = image->ptr<std::uint8_t>(v)[u];
+    const Eigen::Vector3f& ray_c = rays_c_[index];
+    if (ray_c.isZero()) {
+      pixel = 0;
+      return;
     }
-  }
+    Eigen::Vector3f d = R_w_c * ray_c;
+    for (int a = 0; a < 3; ++a) {
+      if (std::abs(d[a]) < 1e-9f) d[a] = 1e-9f;
+    }
+    const SurfaceHit hit = CastRay(room_min_, room_max_, boxes_, boxes, num_boxes, p_w_c, d);
+    const Eigen::Vector3f p = p_w_c + hit.t * d;
+    const int a1 = (hit.axis + 1) % 3, a2 = (hit.axis + 2) % 3;
+    const float footprint = hit.t / (focal * std::max(std::abs(d[hit.axis]), 0.2f));
+    float grey = SurfaceGrey(hit.surface, p[a1], p[a2], footprint);
+    if (noise_sigma > 0.0f) grey += noise_sigma * HashNormal(Mix(noise_key * 0x2545f4914f6cdd1dULL + index));
+    pixel = static_cast<std::uint8_t>(std::clamp(grey + 0.5f, 0.0f, 255.0f));
+  });
 }
 
 }  // namespace vio::tools

@@ -28,7 +28,7 @@ struct PolicyOptions {
 
 /// Gauss-Newton through Ceres.
 struct SolverOptions {
-  int max_iterations = 10;        ///< Gauss-Newton iterations per frame [count]
+  int max_iterations = 3;         ///< Gauss-Newton iterations per frame [count]
   double max_solver_time_s = 0.05;  ///< wall-time bound per solve [s]
   double function_tolerance = 1e-6;  ///< relative cost decrease that counts as converged []
   int num_threads = 1;            ///< Ceres threads [count]
@@ -47,7 +47,7 @@ struct ModelOptions {
   double pixel_sigma = 0.5;        ///< stereo measurement noise, each of (u_L, u_R, v) [px]
   double huber_px = 1.5;           ///< Huber loss threshold in whitened units [sigma]; 0 = none
   double gravity = 9.81;           ///< gravity magnitude, world -z [m/s^2]
-  double imu_noise_scale = 1.0;    ///< multiplies the IMU noise densities of sensor.yaml []
+  double imu_noise_scale = 5.0;    ///< multiplies the IMU noise densities of sensor.yaml []
   double min_disparity_px = 1.0;   ///< new landmarks need at least this stereo disparity [px]
   double max_depth_m = 30.0;       ///< new landmarks beyond this depth are not added [m]
   double reintegrate_bias_threshold = 0.01;  ///< re-preintegrate when the gyro bias moved [rad/s]

@@ -123,6 +123,7 @@ class Window {
   using ObservationKey = std::pair<StateId, LandmarkId>;
 
   void AddImuResidual(ImuEdge& edge);
+  std::shared_ptr<ceres::ParameterBlockOrdering> SchurOrdering() const;
   void ForgetResidualsOf(const std::set<const double*>& removed_blocks);
   void RemoveStateBookkeeping(StateId id);
 

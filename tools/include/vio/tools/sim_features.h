@@ -26,8 +26,9 @@
 namespace vio::tools {
 
 struct FeatureSimOptions {
-  /// Nearest and farthest observable landmark [m].
+  /// Nearest observable landmark [m].
   double min_range_m = 0.25;
+  /// Farthest observable landmark [m].
   double max_range_m = 20.0;
   /// Standard deviation of the pixel noise, per coordinate [px].
   double pixel_noise_px = 0.5;
@@ -35,8 +36,9 @@ struct FeatureSimOptions {
   double outlier_rate = 0.0;
   /// Feature budget per frame (cam0 tracks).
   int max_features = 150;
-  /// Grid of image cells new features are spread over (columns x rows).
+  /// Columns of the grid of image cells new features are spread over.
   int grid_cols = 8;
+  /// Rows of that grid.
   int grid_rows = 6;
   /// Observations keep this distance to the image border [px].
   double border_px = 2.0;

@@ -13,6 +13,7 @@
 // levels whose cells would be smaller than 3 pixels are skipped (cheap
 // anti-aliasing). Plenty of corners for FAST/BRISK, no per-pixel allocation.
 #include <array>
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -35,7 +36,8 @@ struct RenderOptions {
 class SceneRenderer {
  public:
   /// Precomputes the ray table of `camera`. The scene must outlive the
-  /// renderer.
+  /// renderer. Throws std::invalid_argument when the room extends beyond
+  /// 150 m from the world origin.
   SceneRenderer(const Scene& scene, const CameraCalibration& camera, const RenderOptions& options);
 
   /// Renders into `image` (CV_8UC1, width x height; reallocated when needed)
@@ -62,13 +64,27 @@ class SceneRenderer {
   };
   void BuildRayTable();
   void BuildTextures();
+  /// Calls f(u, v, row-major index) for every pixel of a tile.
+  template <class F>
+  void ForEachPixel(int tile, F f) const {
+    const int x0 = (tile % tiles_x_) * kTileSize, y0 = (tile / tiles_x_) * kTileSize;
+    for (int v = y0; v < std::min(camera_.height, y0 + kTileSize); ++v) {
+      for (int u = x0; u < std::min(camera_.width, x0 + kTileSize); ++u) {
+        f(u, v, static_cast<std::size_t>(v) * camera_.width + u);
+      }
+    }
+  }
+
   std::vector<int> BoxesPerTile(const Eigen::Isometry3d& T_w_c) const;
   void RenderTile(int tile, const Eigen::Matrix3f& R_w_c, const Eigen::Vector3f& p_w_c,
                   const int* boxes, int num_boxes, std::uint64_t noise_key, cv::Mat* image) const;
 
+  static constexpr int kTileSize = 16;  // [px]
+
   const Scene& scene_;
   CameraCalibration camera_;
   RenderOptions options_;
+  Eigen::Vector3f room_min_, room_max_;
   int tiles_x_ = 0, tiles_y_ = 0;
   std::vector<Eigen::Vector3f> rays_c_;  // row-major, unit; zero when not undistortable
   std::vector<Tile> tiles_;

@@ -26,12 +26,13 @@ struct SceneOptions {
   double trajectory_margin_m = 0.3;
   /// Number of clutter boxes on the floor (fewer when they do not fit).
   int num_boxes = 8;
-  /// Smallest and largest box edge [m].
+  /// Smallest box edge [m].
   double box_min_size_m = 0.4;
+  /// Largest box edge [m] (heights also stay 0.5 m below the ceiling).
   double box_max_size_m = 1.5;
   /// Minimum distance between a box and the trajectory [m].
   double box_clearance_m = 0.6;
-  /// Landmarks per square metre of surface.
+  /// Landmarks per square metre of surface [1/m^2].
   double landmark_density_per_m2 = 10.0;
 };
 

@@ -1,0 +1,90 @@
+// `vio run` end to end on a short synthetic dataset the simulator makes:
+// the SWF tracks the ground truth, and the same command twice writes
+// byte-identical trajectories.
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "test_data.h"
+#include "vio/tools/run.h"
+#include "vio/tools/simulator.h"
+
+namespace vio::tools {
+namespace {
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+const std::string& SyntheticDataset() {
+  static const std::string dir = [] {
+    SimulatorOptions options;
+    options.output_dir = test::MakeTempDir("run_synthetic") + "/dataset";
+    options.duration_s = 15.0;
+    options.seed = 3;
+    Simulate(options);
+    return options.output_dir;
+  }();
+  return dir;
+}
+
+RunResult RunOnSynthetic(const std::string& output_dir) {
+  RunRequest request;
+  request.dataset_dir = SyntheticDataset();
+  request.output_dir = output_dir;
+  request.show_progress = false;
+  return RunDataset(request);
+}
+
+TEST(RunSynthetic, SwfTracksTheSyntheticFlight) {
+  const std::string out = test::MakeTempDir("run_synthetic_out");
+  const RunResult result = RunOnSynthetic(out);
+  EXPECT_EQ(result.status, "ok");
+  EXPECT_GE(result.frames_estimated, result.frames - 2);
+  ASSERT_TRUE(result.evaluation.has_value());
+  EXPECT_LT(result.evaluation->ate.rmse_m, 0.03);
+  EXPECT_LT(result.evaluation->ate.rot_rmse_deg, 1.0);
+  for (const char* file : {"trajectory.txt", "summary.json", "timing.csv", "config.yaml"}) {
+    EXPECT_TRUE(std::filesystem::exists(out + "/" + file)) << file;
+  }
+}
+
+// `vio run` twice as separate processes, exactly as a user would.
+TEST(RunSynthetic, SameCommandTwiceGivesByteIdenticalTrajectories) {
+  const std::string a = test::MakeTempDir("run_det_a");
+  const std::string b = test::MakeTempDir("run_det_b");
+  for (const std::string& out : {a, b}) {
+    const std::string command = std::string(VIO_BINARY) + " run --dataset=" + SyntheticDataset() +
+                                " --output_dir=" + out + " > " + out + "/log.txt 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  }
+  const std::string trajectory = ReadFile(a + "/trajectory.txt");
+  EXPECT_GT(trajectory.size(), 1000u);
+  EXPECT_EQ(trajectory, ReadFile(b + "/trajectory.txt"));
+}
+
+TEST(RunSynthetic, DatasetWithoutFeaturesIsAClearError) {
+  const std::string dir = test::MakeTempDir("run_nofeatures");
+  EurocDataset dataset = ReadEuroc(SyntheticDataset());
+  dataset.features.clear();
+  WriteEuroc(dataset, dir);
+  RunRequest request;
+  request.dataset_dir = dir;
+  request.output_dir = dir + "/out";
+  request.show_progress = false;
+  try {
+    RunDataset(request);
+    FAIL() << "ran without features";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("features0/data.csv"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace vio::tools
