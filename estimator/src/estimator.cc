@@ -89,25 +89,42 @@ void Estimator::AddFirstState(const InitialState& initial) {
   waiting_reason_.clear();
 }
 
-// Predicts the new state from the last one through the preintegrated IMU
-// (Forster et al. eq. 33) and links the two by an IMU factor.
-void Estimator::AddPropagatedState(Timestamp t_ns) {
+// The state at t_ns predicted from the last one through the preintegrated
+// IMU (Forster et al. eq. 33), with the preintegration that links them.
+Estimator::Prediction Estimator::Predict(Timestamp t_ns) const {
   const State& last = window_.state(last_state_);
-  ImuPreintegration pre = PreintegrateBetween(imu_, last.t_ns, t_ns, ImuBias{last.gyro_bias(), last.accel_bias()},
-                                              imu_calibration_);
+  Prediction out{PreintegrateBetween(imu_, last.t_ns, t_ns, ImuBias{last.gyro_bias(), last.accel_bias()},
+                                     imu_calibration_)};
+  const ImuPreintegration::Deltas& d = out.preintegration.deltas();
   const Eigen::Vector3d g_w(0, 0, -options_.model.gravity);
   const double dt = NanosToSeconds(t_ns - last.t_ns);
   const Eigen::Matrix3d R_w_i = last.q_w_b().toRotationMatrix();
-  const Eigen::Vector3d p = last.p_w_b() + last.v_w_b() * dt + 0.5 * g_w * dt * dt + R_w_i * pre.deltas().delta_p;
-  const Eigen::Vector3d v = last.v_w_b() + g_w * dt + R_w_i * pre.deltas().delta_v;
-  const Eigen::Quaterniond q = last.q_w_b() * pre.deltas().delta_q;
+  out.p_w_b = last.p_w_b() + last.v_w_b() * dt + 0.5 * g_w * dt * dt + R_w_i * d.delta_p;
+  out.v_w_b = last.v_w_b() + g_w * dt + R_w_i * d.delta_v;
+  out.q_w_b = (last.q_w_b() * d.delta_q).normalized();
+  return out;
+}
+
+std::optional<Eigen::Isometry3d> Estimator::PredictBodyPose(Timestamp t_ns) const {
+  if (!last_state_.valid() || imu_.empty() || imu_.back().t_ns < t_ns) return std::nullopt;
+  const Prediction p = Predict(t_ns);
+  Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();
+  T_w_b.linear() = p.q_w_b.toRotationMatrix();
+  T_w_b.translation() = p.p_w_b;
+  return T_w_b;
+}
+
+// Adds the predicted state and links it to the last one by an IMU factor.
+void Estimator::AddPropagatedState(Timestamp t_ns) {
+  Prediction p = Predict(t_ns);
+  const State& last = window_.state(last_state_);
   const Eigen::Vector3d b_g = last.gyro_bias(), b_a = last.accel_bias();
   const StateId previous = last_state_;
   last_state_ = StateId(next_state_id_++);
   State& s = window_.AddState(last_state_, t_ns);
-  s.SetPose(p, q);
-  s.SetSpeedBias(v, b_g, b_a);
-  window_.AddImuFactor(previous, last_state_, std::move(pre));
+  s.SetPose(p.p_w_b, p.q_w_b);
+  s.SetSpeedBias(p.v_w_b, b_g, b_a);
+  window_.AddImuFactor(previous, last_state_, std::move(p.preintegration));
 }
 
 FrameEstimate Estimator::Estimate(const StereoFrame& frame) const {

@@ -15,7 +15,7 @@
 #include "vio/frontend/stereo_rectifier.h"
 #include "vio/tools/euroc_dataset.h"
 #include "vio/tools/progress.h"
-#include "vio/tools/stereo_frames.h"
+#include "vio/tools/frame_source.h"
 
 namespace vio::tools {
 namespace {
@@ -34,13 +34,9 @@ void ApplyCalibrationSource(const CalibrationOptions& options, EurocDataset* dat
 
 EurocDataset ReadRunDataset(const RunRequest& request) {
   EurocReadOptions read;
-  read.check_images = false;  // the features front end reads no images
+  read.check_images = request.config.frontend.frontend != "features";
   EurocDataset dataset = ReadEuroc(request.dataset_dir, read);
   ApplyCalibrationSource(request.config.calibration, &dataset);
-  if (dataset.features.empty()) {
-    throw std::runtime_error(request.dataset_dir + ": no mav0/features0/data.csv: the 'features' front end needs it "
-                             "(generate one with `vio simulate --from=" + request.dataset_dir + "`)");
-  }
   return dataset;
 }
 
@@ -73,55 +69,61 @@ double PeakMemoryMb() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
 }
 
+// Gives the estimator the IMU up to and including the first sample at or
+// after t_ns; false when the IMU ends before t_ns.
+bool FeedImuUpTo(const std::vector<ImuSample>& imu, Timestamp t_ns, size_t* next, Estimator* estimator) {
+  while (*next < imu.size() && (*next == 0 || imu[*next - 1].t_ns < t_ns)) estimator->AddImu(imu[(*next)++]);
+  return *next > 0 && imu[*next - 1].t_ns >= t_ns;
+}
+
+// The frame loop: IMU, (ground-truth start), front end, estimator, output.
+void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, FrameSource& source,
+                    Estimator& estimator, RunOutput& output, RunResult* result) {
+  const auto num_frames = static_cast<std::int64_t>(source.size());
+  ProgressBar progress = request.show_progress ? ProgressBar(num_frames, "frames")
+                                               : ProgressBar(num_frames, "frames", nullptr, false);
+  const bool init_from_gt = request.config.estimator.init.init == "groundtruth";
+  size_t next_imu = 0;
+  for (size_t k = 0; k < source.size(); ++k) {
+    if (!FeedImuUpTo(dataset.imu, source.time(k), &next_imu, &estimator)) break;
+    if (init_from_gt && result->frames_estimated == 0) {
+      const std::optional<InitialState> gt = GroundTruthAt(dataset.groundtruth, source.time(k));
+      if (!gt) continue;  // frame before the ground-truth span: no state to start from
+      estimator.SetInitialState(*gt);
+    }
+    const FrameEstimate estimate = estimator.ProcessFrame(source.Frame(k, estimator));
+    progress.Update(static_cast<std::int64_t>(k + 1));
+    if (!estimate.initialized) continue;
+    if (Diverged(estimate)) {
+      result->status = "diverged";
+      LOG(ERROR) << "estimate diverged at t=" << NanosToSeconds(estimate.t_ns) << " s (frame " << k << ")";
+      break;
+    }
+    output.AddFrame(estimate);
+    ++result->frames_estimated;
+  }
+  progress.Finish();
+}
+
 }  // namespace
 
 RunResult RunDataset(const RunRequest& request) {
   const EurocDataset dataset = ReadRunDataset(request);
   const frontend::StereoRectifier rectifier(dataset.cameras[0], dataset.cameras[1]);
-  StereoFramesReport frames_report;
-  const std::vector<StereoFrame> frames = StereoFramesFromFeatures(
-      dataset.features, dataset.frames[0], rectifier, request.config.frontend.max_epipolar_px, &frames_report);
-  const EstimatorOptions& options = request.config.estimator;
-  Estimator estimator(options, dataset.imu_calibration, rectifier.rectified());
-
-  RunResult result;
-  result.frames = static_cast<int>(frames.size());
-  if (!frames.empty()) result.dataset_duration_s = NanosToSeconds(frames.back().t_ns - frames.front().t_ns);
-  RunOutput output(request.output_dir);
-  const auto num_frames = static_cast<std::int64_t>(frames.size());
-  ProgressBar progress = request.show_progress ? ProgressBar(num_frames, "frames")
-                                               : ProgressBar(num_frames, "frames", nullptr, false);
-  const bool init_from_gt = options.init.init == "groundtruth";
-  if (init_from_gt && dataset.groundtruth.empty()) {
+  const std::unique_ptr<FrameSource> source = MakeFrameSource(request.config, dataset, rectifier);
+  if (request.config.estimator.init.init == "groundtruth" && dataset.groundtruth.empty()) {
     throw std::runtime_error(request.dataset_dir + ": --init=groundtruth but the dataset has no ground truth");
   }
-  size_t next_imu = 0;
-  const auto start = std::chrono::steady_clock::now();
-  for (size_t k = 0; k < frames.size(); ++k) {
-    const StereoFrame& frame = frames[k];
-    // IMU up to and including the first sample at or after the frame.
-    while (next_imu < dataset.imu.size() && (next_imu == 0 || dataset.imu[next_imu - 1].t_ns < frame.t_ns)) {
-      estimator.AddImu(dataset.imu[next_imu++]);
-    }
-    if (next_imu == 0 || dataset.imu[next_imu - 1].t_ns < frame.t_ns) break;  // IMU ends before the frame
-    if (init_from_gt && result.frames_estimated == 0) {
-      const std::optional<InitialState> gt = GroundTruthAt(dataset.groundtruth, frame.t_ns);
-      if (!gt) continue;  // frame before the ground-truth span: no state to start from
-      estimator.SetInitialState(*gt);
-    }
-    const FrameEstimate estimate = estimator.ProcessFrame(frame);
-    progress.Update(static_cast<std::int64_t>(k + 1));
-    if (!estimate.initialized) continue;
-    if (Diverged(estimate)) {
-      result.status = "diverged";
-      LOG(ERROR) << "estimate diverged at t=" << NanosToSeconds(frame.t_ns) << " s (frame " << k << ")";
-      break;
-    }
-    output.AddFrame(estimate);
-    ++result.frames_estimated;
+  Estimator estimator(request.config.estimator, dataset.imu_calibration, rectifier.rectified());
+  RunOutput output(request.output_dir);
+  RunResult result;
+  result.frames = static_cast<int>(source->size());
+  if (source->size() > 0) {
+    result.dataset_duration_s = NanosToSeconds(source->time(source->size() - 1) - source->time(0));
   }
+  const auto start = std::chrono::steady_clock::now();
+  EstimateFrames(request, dataset, *source, estimator, output, &result);
   result.processing_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  progress.Finish();
   if (result.frames_estimated == 0 && result.status == "ok") result.status = "not_initialized";
   result.ms_per_frame = result.frames_estimated ? 1e3 * result.processing_s / result.frames_estimated : 0.0;
   result.real_time_factor = result.processing_s > 0 ? result.dataset_duration_s / result.processing_s : 0.0;
@@ -130,7 +132,7 @@ RunResult RunDataset(const RunRequest& request) {
   }
   output.WriteTrajectory();
   output.WriteTiming();
-  output.WriteSummary(result, frames_report, request, PeakMemoryMb(), estimator.waiting_reason());
+  output.WriteSummary(result, source->ReportJson(), request, PeakMemoryMb(), estimator.waiting_reason());
   output.WriteConfig(RunConfigToYaml(request.config));
   return result;
 }

@@ -41,16 +41,6 @@ std::string StageTimesJson(const std::vector<FrameEstimate>& f) {
   return os.str();
 }
 
-std::string FramesReportJson(const StereoFramesReport& r) {
-  std::ostringstream os;
-  os << "{\"frames\": " << r.frames << ", \"stereo_observations\": " << r.stereo_observations
-     << ", \"left_only\": " << r.left_only << ", \"right_only\": " << r.right_only
-     << ", \"rejected_epipolar\": " << r.rejected_epipolar << ", \"rejected_disparity\": " << r.rejected_disparity
-     << ", \"unrectifiable\": " << r.unrectifiable << ", \"observations_off_frames\": " << r.observations_off_frames
-     << "}";
-  return os.str();
-}
-
 std::string JsonString(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
@@ -95,7 +85,7 @@ void RunOutput::WriteTiming() const {
   }
 }
 
-void RunOutput::WriteSummary(const RunResult& r, const StereoFramesReport& frames, const RunRequest& request,
+void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_json, const RunRequest& request,
                              double peak_memory_mb, const std::string& waiting_reason) const {
   std::ofstream out = OpenForWriting(dir_ + "/summary.json");
   const PolicyOptions& policy = request.config.estimator.policy;
@@ -106,7 +96,7 @@ void RunOutput::WriteSummary(const RunResult& r, const StereoFramesReport& frame
       << ",\n  \"processing_s\": " << Number(r.processing_s) << ",\n  \"ms_per_frame\": " << Number(r.ms_per_frame)
       << ",\n  \"real_time_factor\": " << Number(r.real_time_factor)
       << ",\n  \"stage_ms_per_frame\": " << StageTimesJson(frames_)
-      << ",\n  \"peak_memory_mb\": " << Number(peak_memory_mb) << ",\n  \"frontend\": " << FramesReportJson(frames);
+      << ",\n  \"peak_memory_mb\": " << Number(peak_memory_mb) << ",\n  \"frontend\": " << frontend_json;
   if (!waiting_reason.empty()) out << ",\n  \"not_initialized_reason\": " << JsonString(waiting_reason);
   if (r.evaluation) {
     std::string evaluation = ToJson(*r.evaluation);

@@ -6,7 +6,6 @@
 #include "vio/estimator/estimator.h"
 #include "vio/tools/euroc_dataset.h"
 #include "vio/tools/run.h"
-#include "vio/tools/stereo_frames.h"
 
 namespace vio::tools {
 
@@ -21,7 +20,7 @@ class RunOutput {
 
   void WriteTrajectory() const;
   void WriteTiming() const;
-  void WriteSummary(const RunResult& result, const StereoFramesReport& frames, const RunRequest& request,
+  void WriteSummary(const RunResult& result, const std::string& frontend_json, const RunRequest& request,
                     double peak_memory_mb, const std::string& waiting_reason) const;
   void WriteConfig(const std::string& yaml) const;
 

@@ -4,6 +4,7 @@
 // preintegrated IMU factor) and hands the frame to the policy, which works
 // on the window.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,11 +48,22 @@ class Estimator {
   /// Processes one stereo frame; IMU up to its time must have been added.
   FrameEstimate ProcessFrame(const StereoFrame& frame);
 
+  /// The body pose at t_ns predicted by the IMU from the newest state (for a
+  /// front end's outlier rejection); nothing before initialization or when
+  /// the IMU does not reach t_ns yet.
+  std::optional<Eigen::Isometry3d> PredictBodyPose(Timestamp t_ns) const;
+
   const Window& window() const { return window_; }
   /// Why static initialization has not happened yet (empty once initialized).
   const std::string& waiting_reason() const { return waiting_reason_; }
 
  private:
+  struct Prediction {
+    ImuPreintegration preintegration;
+    Eigen::Vector3d p_w_b, v_w_b;
+    Eigen::Quaterniond q_w_b;
+  };
+  Prediction Predict(Timestamp t_ns) const;
   bool Initialize(const StereoFrame& frame);
   void AddFirstState(const InitialState& initial);
   void AddPropagatedState(Timestamp t_ns);

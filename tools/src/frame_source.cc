@@ -1,0 +1,49 @@
+#include "vio/tools/frame_source.h"
+
+#include <sstream>
+#include <stdexcept>
+
+#include "vio/tools/stereo_frames.h"
+
+namespace vio::tools {
+namespace {
+
+// The `features` front end: features0/data.csv rectified up front.
+class FeaturesSource final : public FrameSource {
+ public:
+  FeaturesSource(const EurocDataset& dataset, const frontend::StereoRectifier& rectifier, double max_epipolar_px)
+      : frames_(StereoFramesFromFeatures(dataset.features, dataset.frames[0], rectifier, max_epipolar_px,
+                                         &report_)) {}
+
+  size_t size() const override { return frames_.size(); }
+  Timestamp time(size_t k) const override { return frames_[k].t_ns; }
+  StereoFrame Frame(size_t k, const Estimator&) override { return frames_[k]; }
+
+  std::string ReportJson() const override {
+    const StereoFramesReport& r = report_;
+    std::ostringstream os;
+    os << "{\"source\": \"features\", \"frames\": " << r.frames << ", \"stereo_observations\": "
+       << r.stereo_observations << ", \"left_only\": " << r.left_only << ", \"right_only\": " << r.right_only
+       << ", \"rejected_epipolar\": " << r.rejected_epipolar << ", \"rejected_disparity\": " << r.rejected_disparity
+       << ", \"unrectifiable\": " << r.unrectifiable << ", \"observations_off_frames\": "
+       << r.observations_off_frames << "}";
+    return os.str();
+  }
+
+ private:
+  StereoFramesReport report_;
+  std::vector<StereoFrame> frames_;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSource> MakeFrameSource(const RunConfig& config, const EurocDataset& dataset,
+                                             const frontend::StereoRectifier& rectifier) {
+  if (dataset.features.empty()) {
+    throw std::runtime_error(dataset.root + ": no mav0/features0/data.csv: the 'features' front end needs it "
+                             "(generate one with `vio simulate --from=" + dataset.root + "`)");
+  }
+  return std::make_unique<FeaturesSource>(dataset, rectifier, config.frontend.max_epipolar_px);
+}
+
+}  // namespace vio::tools
