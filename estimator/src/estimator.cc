@@ -127,6 +127,25 @@ void Estimator::AddPropagatedState(Timestamp t_ns) {
   window_.AddImuFactor(previous, last_state_, std::move(p.preintegration));
 }
 
+std::vector<FrameEstimate> Estimator::Finish() {
+  std::vector<FrameEstimate> smoothed;
+  if (!last_state_.valid() || !policy_->Finish(window_)) return smoothed;
+  for (const auto& [id, s] : window_.states()) smoothed.push_back(EstimateOf(s));
+  return smoothed;
+}
+
+FrameEstimate Estimator::EstimateOf(const State& s) const {
+  FrameEstimate e;
+  e.t_ns = s.t_ns;
+  e.initialized = true;
+  e.p_w_b = s.p_w_b();
+  e.q_w_b = s.q_w_b();
+  e.v_w_b = s.v_w_b();
+  e.gyro_bias = s.gyro_bias();
+  e.accel_bias = s.accel_bias();
+  return e;
+}
+
 FrameEstimate Estimator::Estimate(const StereoFrame& frame) const {
   const State& s = window_.state(last_state_);
   FrameEstimate e;

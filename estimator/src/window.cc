@@ -1,5 +1,6 @@
 #include "vio/estimator/window.h"
 
+#include <algorithm>
 #include <limits>
 
 #include <glog/logging.h>
@@ -145,8 +146,19 @@ std::shared_ptr<ceres::ParameterBlockOrdering> Window::SchurOrdering() const {
 
 SolveReport Window::Solve(const SolverOptions& options) {
   ceres::Solver::Options solver;
-  solver.linear_solver_type = ceres::DENSE_SCHUR;
   solver.linear_solver_ordering = SchurOrdering();
+  // With nothing to eliminate (every landmark tied into a prior, as in
+  // EKF-SLAM) the Schur complement only adds overhead.
+  const bool eliminable = solver.linear_solver_ordering->GroupSize(0) > 0;
+  if (options.linear_solver == "iterative") {
+    solver.linear_solver_type = eliminable ? ceres::ITERATIVE_SCHUR : ceres::CGNR;
+    solver.preconditioner_type = eliminable ? ceres::SCHUR_JACOBI : ceres::JACOBI;
+  } else if (options.linear_solver == "sparse") {
+    solver.linear_solver_type = eliminable ? ceres::SPARSE_SCHUR : ceres::SPARSE_NORMAL_CHOLESKY;
+  } else {
+    solver.linear_solver_type = eliminable ? ceres::DENSE_SCHUR : ceres::DENSE_NORMAL_CHOLESKY;
+  }
+  if (!eliminable) solver.linear_solver_ordering.reset();
   solver.max_num_iterations = options.max_iterations;
   solver.max_solver_time_in_seconds = options.max_solver_time_s;
   solver.function_tolerance = options.function_tolerance;
@@ -162,6 +174,29 @@ SolveReport Window::Solve(const SolverOptions& options) {
   report.usable = summary.IsSolutionUsable();
   return report;
 }
+
+void Window::SetStateConstant(StateId id, bool constant) {
+  State& s = state(id);
+  for (double* block : {s.pose, s.speed_bias}) {
+    if (constant) {
+      problem_->SetParameterBlockConstant(block);
+    } else {
+      problem_->SetParameterBlockVariable(block);
+    }
+  }
+}
+
+void Window::SetLandmarkConstant(LandmarkId id, bool constant) {
+  auto it = landmarks_.find(id);
+  CHECK(it != landmarks_.end()) << "no landmark " << id.value << " in the window";
+  if (constant) {
+    problem_->SetParameterBlockConstant(it->second.p_w);
+  } else {
+    problem_->SetParameterBlockVariable(it->second.p_w);
+  }
+}
+
+bool Window::IsStateConstant(StateId id) const { return problem_->IsParameterBlockConstant(state(id).pose); }
 
 int Window::RefreshImuFactors(double gyro_bias_threshold) {
   int refreshed = 0;
@@ -246,6 +281,42 @@ void Window::DropLandmark(LandmarkId landmark_id) {
   ForgetResidualsOf(removed);
   problem_->RemoveParameterBlock(it->second.p_w);
   landmarks_.erase(landmark_id);
+}
+
+bool Window::IsInPrior(StateId id) const {
+  const State& s = state(id);
+  for (const Prior& prior : priors_) {
+    for (const double* block : prior.blocks) {
+      if (block == s.pose || block == s.speed_bias) return true;
+    }
+  }
+  return false;
+}
+
+void Window::DropState(StateId id) {
+  CHECK(!IsInPrior(id)) << "state " << id.value << " is in a prior: marginalize it instead";
+  auto incoming = imu_edges_.find(id);
+  auto outgoing = std::find_if(imu_edges_.begin(), imu_edges_.end(), [&](const auto& e) { return e.second.from == id; });
+  CHECK(incoming != imu_edges_.end() && outgoing != imu_edges_.end())
+      << "state " << id.value << " is not between two others";
+  std::vector<LandmarkId> seen;
+  for (const auto& [key, observation] : observations_) {
+    if (key.first == id) seen.push_back(key.second);
+  }
+  for (LandmarkId landmark_id : seen) {
+    DropObservation(id, landmark_id);
+    if (landmarks_.at(landmark_id).observed_from.empty()) DropLandmark(landmark_id);
+  }
+  ImuEdge merged{incoming->second.from, outgoing->first, incoming->second.preintegration};
+  merged.preintegration.Append(outgoing->second.preintegration);
+  imu_edges_.erase(outgoing);
+  imu_edges_.erase(incoming);
+  State& s = state(id);
+  problem_->RemoveParameterBlock(s.pose);
+  problem_->RemoveParameterBlock(s.speed_bias);
+  states_.erase(id);
+  ImuEdge& edge = imu_edges_.emplace(merged.to, std::move(merged)).first->second;
+  AddImuResidual(edge);
 }
 
 double Window::ObservationError(StateId state_id, LandmarkId landmark_id) const {

@@ -7,7 +7,6 @@
 #include <unordered_set>
 #include <utility>
 
-#include <Eigen/SparseCore>
 #include <ceres/crs_matrix.h>
 #include <glog/logging.h>
 
@@ -138,6 +137,39 @@ int TangentDim(const ceres::Problem& problem, const std::vector<double*>& blocks
   return dim;
 }
 
+/// H = J^T J, b = J^T r of a CRS Jacobian. Sparse rows (a factor touching a
+/// few blocks) add their outer products entry by entry; dense rows (an
+/// earlier prior spanning the blanket) are gathered into one dense matrix
+/// whose product is left to Eigen's blocked kernels.
+NormalEquations NormalEquationsOf(const ceres::CRSMatrix& J, const std::vector<double>& r) {
+  constexpr int kDenseRow = 64;  // nonzeros from which a row counts as dense
+  const int n = J.num_cols;
+  NormalEquations eq{Eigen::MatrixXd::Zero(n, n), Eigen::VectorXd::Zero(n)};
+  std::vector<int> dense_rows;
+  for (int i = 0; i < J.num_rows; ++i) {
+    const int begin = J.rows[i], end = J.rows[i + 1];
+    if (end - begin > kDenseRow) {
+      dense_rows.push_back(i);
+      continue;
+    }
+    for (int a = begin; a < end; ++a) {
+      eq.b[J.cols[a]] += J.values[a] * r[i];
+      for (int c = begin; c < end; ++c) eq.H(J.cols[a], J.cols[c]) += J.values[a] * J.values[c];
+    }
+  }
+  if (dense_rows.empty()) return eq;
+  Eigen::MatrixXd Jd = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(dense_rows.size()), n);
+  Eigen::VectorXd rd(Jd.rows());
+  for (Eigen::Index k = 0; k < Jd.rows(); ++k) {
+    const int i = dense_rows[k];
+    for (int a = J.rows[i]; a < J.rows[i + 1]; ++a) Jd(k, J.cols[a]) = J.values[a];
+    rd[k] = r[i];
+  }
+  eq.H.noalias() += Jd.transpose() * Jd;
+  eq.b.noalias() += Jd.transpose() * rd;
+  return eq;
+}
+
 /// H = J^T J and b = J^T r of the blanket's residual blocks, columns in the
 /// order [kept, marg_dense, marg_uncoupled], on the tangent spaces.
 NormalEquations Linearize(ceres::Problem* problem, const MarkovBlanket& blanket) {
@@ -154,12 +186,7 @@ NormalEquations Linearize(ceres::Problem* problem, const MarkovBlanket& blanket)
   if (!problem->Evaluate(evaluate, &cost, &residuals, nullptr, &jacobian)) {
     throw std::runtime_error("marginalization: Problem::Evaluate failed on the Markov blanket");
   }
-  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> J(
-      jacobian.num_rows, jacobian.num_cols, static_cast<int>(jacobian.values.size()),
-      jacobian.rows.data(), jacobian.cols.data(), jacobian.values.data());
-  const Eigen::Map<const Eigen::VectorXd> r(residuals.data(), static_cast<int>(residuals.size()));
-  const Eigen::SparseMatrix<double> JtJ = J.transpose() * J;
-  return NormalEquations{Eigen::MatrixXd(JtJ), J.transpose() * r};
+  return NormalEquationsOf(jacobian, residuals);
 }
 
 std::vector<MarginalizationPrior::Block> PriorBlocks(const ceres::Problem& problem,

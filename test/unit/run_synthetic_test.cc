@@ -34,13 +34,31 @@ const std::string& SyntheticDataset() {
   return dir;
 }
 
-RunResult RunOnSynthetic(const std::string& output_dir) {
+RunResult RunOnSynthetic(const std::string& output_dir, const std::string& policy = "swf") {
   RunRequest request;
   request.dataset_dir = SyntheticDataset();
   request.output_dir = output_dir;
   request.show_progress = false;
+  request.config.estimator.policy.policy = policy;
   return RunDataset(request);
 }
+
+// Every policy runs the whole flight and stays close to the ground truth.
+class EveryPolicy : public ::testing::TestWithParam<std::pair<std::string, double>> {};
+
+TEST_P(EveryPolicy, TracksTheSyntheticFlight) {
+  const auto& [policy, ate_bound_m] = GetParam();
+  const RunResult result = RunOnSynthetic(test::MakeTempDir("run_policy_" + policy), policy);
+  EXPECT_EQ(result.status, "ok") << policy;
+  EXPECT_GE(result.frames_estimated, result.frames - 2) << policy;
+  ASSERT_TRUE(result.evaluation.has_value());
+  EXPECT_LT(result.evaluation->ate.rmse_m, ate_bound_m) << policy;
+}
+
+INSTANTIATE_TEST_SUITE_P(Policies, EveryPolicy,
+                         ::testing::Values(std::make_pair("msckf", 0.05), std::make_pair("fixed_lag", 0.05),
+                                           std::make_pair("keyframe", 0.05)),
+                         [](const auto& info) { return info.param.first; });
 
 TEST(RunSynthetic, SwfTracksTheSyntheticFlight) {
   const std::string out = test::MakeTempDir("run_synthetic_out");

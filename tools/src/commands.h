@@ -14,5 +14,7 @@ namespace vio::tools {
 int RunMain(const std::vector<std::string>& args);
 int SimulateMain(const std::vector<std::string>& args);
 int EvalMain(const std::vector<std::string>& args);
+int VerifyMain(const std::vector<std::string>& args);
+int SweepMain(const std::vector<std::string>& args);
 
 }  // namespace vio::tools

@@ -1,12 +1,22 @@
 #include "vio/tools/frame_source.h"
 
+#include <filesystem>
 #include <sstream>
 #include <stdexcept>
 
+#include "frame_source_images.h"
 #include "vio/tools/stereo_frames.h"
 
 namespace vio::tools {
 namespace {
+
+// True when mav0/cam0/data/ holds any file.
+bool HasImageFiles(const std::string& root) {
+  std::error_code ec;
+  const std::filesystem::path folder = std::filesystem::path(root) / "mav0" / "cam0" / "data";
+  return std::filesystem::is_directory(folder, ec) &&
+         std::filesystem::directory_iterator(folder, ec) != std::filesystem::directory_iterator();
+}
 
 // The `features` front end: features0/data.csv rectified up front.
 class FeaturesSource final : public FrameSource {
@@ -39,9 +49,12 @@ class FeaturesSource final : public FrameSource {
 
 std::unique_ptr<FrameSource> MakeFrameSource(const RunConfig& config, const EurocDataset& dataset,
                                              const frontend::StereoRectifier& rectifier) {
+  if (config.frontend.frontend != "features") return MakeImageFrameSource(config.frontend, dataset, rectifier);
   if (dataset.features.empty()) {
+    const std::string images_hint =
+        HasImageFiles(dataset.root) ? "; it has images: run an image front end with --frontend=brisk or --frontend=klt" : "";
     throw std::runtime_error(dataset.root + ": no mav0/features0/data.csv: the 'features' front end needs it "
-                             "(generate one with `vio simulate --from=" + dataset.root + "`)");
+                             "(generate one with `vio simulate --from=" + dataset.root + "`)" + images_hint);
   }
   return std::make_unique<FeaturesSource>(dataset, rectifier, config.frontend.max_epipolar_px);
 }

@@ -123,6 +123,7 @@ RunResult RunDataset(const RunRequest& request) {
   }
   const auto start = std::chrono::steady_clock::now();
   EstimateFrames(request, dataset, *source, estimator, output, &result);
+  if (result.status == "ok") output.ReplaceEstimates(estimator.Finish());
   result.processing_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (result.frames_estimated == 0 && result.status == "ok") result.status = "not_initialized";
   result.ms_per_frame = result.frames_estimated ? 1e3 * result.processing_s / result.frames_estimated : 0.0;

@@ -6,6 +6,8 @@ void BindRunConfig(RunConfig* config, OptionRegistry* registry) {
   registry->Add("calibration", &config->calibration);
   registry->Add("frontend", &config->frontend);
   registry->Add("policy", &config->estimator.policy);
+  registry->Add("msckf", &config->estimator.msckf);
+  registry->Add("batch", &config->estimator.batch);
   registry->Add("solver", &config->estimator.solver);
   registry->Add("model", &config->estimator.model);
   registry->Add("init", &config->estimator.init);

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <sstream>
 
 namespace vio::tools {
@@ -68,6 +69,20 @@ void RunOutput::AddFrame(const FrameEstimate& estimate) {
   pose.accel_bias = estimate.accel_bias;
   trajectory_.push_back(pose);
   frames_.push_back(estimate);
+}
+
+void RunOutput::ReplaceEstimates(const std::vector<FrameEstimate>& estimates) {
+  std::map<Timestamp, const FrameEstimate*> by_time;
+  for (const FrameEstimate& e : estimates) by_time[e.t_ns] = &e;
+  for (GroundTruthState& pose : trajectory_) {
+    auto it = by_time.find(pose.t_ns);
+    if (it == by_time.end()) continue;
+    pose.p_w_b = it->second->p_w_b;
+    pose.q_w_b = it->second->q_w_b;
+    pose.v_w_b = it->second->v_w_b;
+    pose.gyro_bias = it->second->gyro_bias;
+    pose.accel_bias = it->second->accel_bias;
+  }
 }
 
 void RunOutput::WriteTrajectory() const { WriteTumTrajectory(trajectory_, dir_ + "/trajectory.txt"); }

@@ -15,6 +15,9 @@ class RunOutput {
   explicit RunOutput(std::string dir);
 
   void AddFrame(const FrameEstimate& estimate);
+  /// Overwrites the poses of the frames with these stamps (an offline
+  /// policy's final estimates); timing rows stay.
+  void ReplaceEstimates(const std::vector<FrameEstimate>& estimates);
   /// The estimated poses so far (t, p_w_b, q_w_b).
   const std::vector<GroundTruthState>& trajectory() const { return trajectory_; }
 

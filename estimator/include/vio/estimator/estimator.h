@@ -48,6 +48,11 @@ class Estimator {
   /// Processes one stereo frame; IMU up to its time must have been added.
   FrameEstimate ProcessFrame(const StereoFrame& frame);
 
+  /// Ends the run. For an offline policy (batch) this is where it solves;
+  /// it then returns the final estimate of every state (which replaces the
+  /// per-frame estimates). Online policies return nothing.
+  std::vector<FrameEstimate> Finish();
+
   /// The body pose at t_ns predicted by the IMU from the newest state (for a
   /// front end's outlier rejection); nothing before initialization or when
   /// the IMU does not reach t_ns yet.
@@ -68,6 +73,7 @@ class Estimator {
   void AddFirstState(const InitialState& initial);
   void AddPropagatedState(Timestamp t_ns);
   FrameEstimate Estimate(const StereoFrame& frame) const;
+  FrameEstimate EstimateOf(const State& state) const;
   void PruneImu(Timestamp before_ns);
 
   EstimatorOptions options_;

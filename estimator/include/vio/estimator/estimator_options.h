@@ -14,29 +14,79 @@ struct PolicyOptions {
   int window_size = 10;         ///< states kept in the window [frames]
   /// What happens to landmarks seen by the state that leaves an SWF window.
   std::string swf_landmarks = "marginalize";
+  int keyframe_temporal_window = 3;  ///< keyframe policy: most recent frames always kept [frames]
+  double keyframe_overlap = 0.7;     ///< keyframe policy: new keyframe below this shared-landmark fraction []
 
   template <class V>
   void Visit(V& v) {
-    v("policy", policy, "estimator policy", {"swf"});
+    v("policy", policy,
+      "estimator policy: swf (sliding window), msckf (MSCKF as optimization), ekf (EKF-SLAM: window 1, one GN "
+      "step), iekf (iterated EKF), fixed_lag (MSCKF marginalization, GN to convergence), keyframe (OKVIS-like), "
+      "batch (no marginalization)",
+      {"swf", "msckf", "ekf", "iekf", "fixed_lag", "keyframe", "batch"});
     v("window_size", window_size, "states kept in the sliding window [frames]");
     v("swf_landmarks", swf_landmarks,
       "SWF: landmarks seen by the leaving state are kept (paper-exact, prior over them) "
       "or marginalized with it (prior over states only, faster)",
       {"keep", "marginalize"});
+    v("keyframe_temporal_window", keyframe_temporal_window,
+      "keyframe policy: the most recent frames, always kept [frames]");
+    v("keyframe_overlap", keyframe_overlap,
+      "keyframe policy: a frame sharing less than this fraction of its landmarks with the last keyframe "
+      "becomes a keyframe []");
+  }
+};
+
+/// The MSCKF as optimization (paper Algorithm 4) and the fixed-lag smoother.
+struct MsckfOptions {
+  int msckf_gn_steps = 1;                 ///< Gauss-Newton steps per MSCKF update [count]
+  int msckf_min_track_length = 2;         ///< observations a track needs to be used [frames]
+  double msckf_max_reprojection = 5.0;    ///< triangulation: largest whitened reprojection error [sigma]
+  double msckf_max_landmark_sigma = 2.0;  ///< triangulation: largest position standard deviation [m]
+
+  template <class V>
+  void Visit(V& v) {
+    v("msckf_gn_steps", msckf_gn_steps, "MSCKF: Gauss-Newton steps per update (fixed_lag: to convergence) [count]");
+    v("msckf_min_track_length", msckf_min_track_length, "MSCKF: observations a track needs to be used [frames]");
+    v("msckf_max_reprojection", msckf_max_reprojection,
+      "MSCKF triangulation: largest whitened reprojection error [sigma]");
+    v("msckf_max_landmark_sigma", msckf_max_landmark_sigma,
+      "MSCKF triangulation: largest landmark position standard deviation [m]");
+  }
+};
+
+/// Full batch: no marginalization; old states frozen while running, all
+/// solved together at the end.
+struct BatchOptions {
+  int batch_final_iterations = 20;  ///< Gauss-Newton iterations of the final full solve [count]
+  int batch_solve_every = 5;        ///< while running, solve the recent states every this many frames [frames]
+
+  template <class V>
+  void Visit(V& v) {
+    v("batch_final_iterations", batch_final_iterations,
+      "batch: Gauss-Newton iterations of the final solve over every state and landmark [count]");
+    v("batch_solve_every", batch_solve_every,
+      "batch: while running, solve the recent states every this many frames (IMU prediction between) [frames]");
   }
 };
 
 /// Gauss-Newton through Ceres.
 struct SolverOptions {
   int max_iterations = 3;         ///< Gauss-Newton iterations per frame [count]
-  double max_solver_time_s = 0.05;  ///< wall-time bound per solve [s]
+  double max_solver_time_s = 1.0;   ///< wall-time bound per solve [s] (a run that hits it is not reproducible)
   double function_tolerance = 1e-6;  ///< relative cost decrease that counts as converged []
   int num_threads = 1;            ///< Ceres threads [count]
+  std::string linear_solver = "dense";  ///< reduced system: dense | sparse (SuiteSparse) | iterative (PCG)
 
   template <class V>
   void Visit(V& v) {
     v("max_iterations", max_iterations, "Gauss-Newton iterations per frame [count]");
-    v("max_solver_time_s", max_solver_time_s, "wall-time bound of one solve [s]");
+    v("linear_solver", linear_solver,
+      "reduced (Schur) system: dense Cholesky, sparse Cholesky (large windows) or iterative "
+      "(preconditioned conjugate gradients: batch-sized problems)",
+      {"dense", "sparse", "iterative"});
+    v("max_solver_time_s", max_solver_time_s,
+      "wall-time bound of one solve [s]; a safety net: a run that hits it is not reproducible");
     v("function_tolerance", function_tolerance, "relative cost decrease that counts as converged []");
     v("num_threads", num_threads, "Ceres threads [count]");
   }
@@ -47,7 +97,7 @@ struct ModelOptions {
   double pixel_sigma = 0.5;        ///< stereo measurement noise, each of (u_L, u_R, v) [px]
   double huber_px = 1.5;           ///< Huber loss threshold in whitened units [sigma]; 0 = none
   double gravity = 9.81;           ///< gravity magnitude, world -z [m/s^2]
-  double imu_noise_scale = 5.0;    ///< multiplies the IMU noise densities of sensor.yaml []
+  double imu_noise_scale = 10.0;    ///< multiplies the IMU noise densities of sensor.yaml []
   double min_disparity_px = 1.0;   ///< new landmarks need at least this stereo disparity [px]
   double max_depth_m = 30.0;       ///< new landmarks beyond this depth are not added [m]
   double reintegrate_bias_threshold = 0.01;  ///< re-preintegrate when the gyro bias moved [rad/s]
@@ -96,6 +146,8 @@ struct InitOptions {
 /// Everything the estimator is configured with.
 struct EstimatorOptions {
   PolicyOptions policy;
+  MsckfOptions msckf;
+  BatchOptions batch;
   SolverOptions solver;
   ModelOptions model;
   InitOptions init;

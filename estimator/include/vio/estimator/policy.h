@@ -25,6 +25,9 @@ class Policy {
   /// Called once per frame after `new_state` (linked to the previous state
   /// by its IMU factor) was added to the window.
   virtual PolicyTiming Update(const StereoFrame& frame, StateId new_state, Window& window) = 0;
+  /// Called once after the last frame. An offline policy (batch) solves here
+  /// and returns true: the window's states are then the run's trajectory.
+  virtual bool Finish(Window& /*window*/) { return false; }
 };
 
 /// The policy named by options.policy.policy. Throws std::invalid_argument

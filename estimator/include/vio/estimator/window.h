@@ -83,6 +83,11 @@ class Window {
   /// Re-preintegrates IMU factors whose gyro-bias linearization moved too far.
   int RefreshImuFactors(double gyro_bias_threshold);
 
+  /// Holds a state's or landmark's blocks fixed in Solve (or frees them).
+  void SetStateConstant(StateId id, bool constant);
+  void SetLandmarkConstant(LandmarkId id, bool constant);
+  bool IsStateConstant(StateId id) const;
+
   // ---- marginalize or drop ---------------------------------------------------
   /// Marginalizes the states and landmarks (with every residual touching them)
   /// into one linearized prior on what they were connected to.
@@ -90,6 +95,12 @@ class Window {
   /// Removes without keeping information.
   void DropObservation(StateId state, LandmarkId landmark);
   void DropLandmark(LandmarkId landmark);
+  /// Removes a state between two others without keeping its information:
+  /// its observations go (and landmarks left unobserved), its two IMU
+  /// factors become one over both intervals. It must not be in a prior.
+  void DropState(StateId id);
+  /// True when a marginalization prior involves the state.
+  bool IsInPrior(StateId id) const;
 
   // ---- queries ---------------------------------------------------------------
   const std::map<StateId, State>& states() const { return states_; }

@@ -1,20 +1,68 @@
 #pragma once
-// Options of the front end: where the per-frame stereo observations come from.
+// Options of the front end: where the per-frame stereo observations come from
+// and the parameters of the two image front ends (paper §5.2 BRISK, KLT).
 #include <string>
 
 namespace vio {
 
 struct FrontendOptions {
-  /// features: the dataset's features0/data.csv (simulated or external tracker).
+  /// features: the dataset's features0/data.csv; brisk / klt: the images.
   std::string frontend = "features";
   /// Stereo pairs whose rectified rows differ by more are rejected [px].
   double max_epipolar_px = 2.0;
+  /// Side of the square cells that spread features over the image [px].
+  double grid_cell_px = 48.0;
+  /// Temporal matches whose reprojection into the IMU-predicted camera is
+  /// further than this from the measurement are rejected [px].
+  double max_reprojection_px = 8.0;
+  /// BRISK: AGAST detection threshold [grey levels].
+  int brisk_threshold = 20;
+  /// BRISK: scale-space octaves.
+  int brisk_octaves = 0;
+  /// BRISK: strongest keypoints kept per grid cell and image [count].
+  int brisk_per_cell = 5;
+  /// BRISK: largest Hamming distance of an accepted descriptor match [bits of 512].
+  int max_hamming_bits = 90;
+  /// BRISK: tracks seen in the last this many frames are matched to the new one [frames].
+  int track_window_frames = 3;
+  /// KLT: features wanted per grid cell; new corners fill cells below it [count].
+  int klt_per_cell = 2;
+  /// KLT: FAST corner threshold [grey levels].
+  int klt_fast_threshold = 20;
+  /// KLT: minimum distance between features [px].
+  double klt_min_distance_px = 15.0;
+  /// KLT: Lucas-Kanade window side [px].
+  int klt_window_px = 15;
+  /// KLT: pyramid levels above the full image.
+  int klt_pyramid_levels = 3;
+  /// KLT: largest forward-backward tracking error [px].
+  double klt_max_fb_px = 1.0;
+  /// Folder receiving one PNG per frame with the tracks drawn; empty = none.
+  std::string debug_images;
 
   template <class V>
   void Visit(V& v) {
-    v("frontend", frontend, "source of stereo observations: the dataset's features0/data.csv",
-      {"features"});
+    v("frontend", frontend,
+      "source of stereo observations: features = the dataset's features0/data.csv, brisk = BRISK matching on "
+      "the images (paper 5.2), klt = Lucas-Kanade tracking on the images",
+      {"features", "brisk", "klt"});
     v("max_epipolar_px", max_epipolar_px, "reject stereo pairs whose rectified rows differ by more [px]");
+    v("grid_cell_px", grid_cell_px, "side of the grid cells spreading image features [px]");
+    v("max_reprojection_px", max_reprojection_px,
+      "reject temporal matches further from their IMU-predicted reprojection [px]");
+    v("brisk_threshold", brisk_threshold, "BRISK AGAST detection threshold [grey levels]");
+    v("brisk_octaves", brisk_octaves, "BRISK scale-space octaves [count]");
+    v("brisk_per_cell", brisk_per_cell, "BRISK keypoints kept per grid cell and image [count]");
+    v("max_hamming_bits", max_hamming_bits, "largest Hamming distance of a BRISK match [bits of 512]");
+    v("track_window_frames", track_window_frames,
+      "BRISK matches the new frame to tracks seen in this many previous frames [frames]");
+    v("klt_per_cell", klt_per_cell, "KLT features wanted per grid cell [count]");
+    v("klt_fast_threshold", klt_fast_threshold, "KLT FAST corner threshold [grey levels]");
+    v("klt_min_distance_px", klt_min_distance_px, "KLT minimum distance between features [px]");
+    v("klt_window_px", klt_window_px, "KLT Lucas-Kanade window side [px]");
+    v("klt_pyramid_levels", klt_pyramid_levels, "KLT pyramid levels above the full image [count]");
+    v("klt_max_fb_px", klt_max_fb_px, "KLT largest forward-backward tracking error [px]");
+    v("debug_images", debug_images, "folder for one PNG per frame with the tracks drawn; empty = none");
   }
 };
 

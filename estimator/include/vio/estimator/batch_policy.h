@@ -1,0 +1,29 @@
+#pragma once
+// Full batch (paper §4.4, graph SLAM / bundle adjustment): no
+// marginalization. Every state and landmark stays; a landmark seen again is
+// the same variable. While the data streams in, the recent states are solved
+// every few frames with the states older than the window (and landmarks only
+// they see) held constant; after the last frame everything is freed and
+// solved together (sparse Schur): the offline reference and the accuracy
+// floor of the online policies.
+#include <set>
+
+#include "vio/estimator/policy.h"
+
+namespace vio {
+
+class BatchPolicy final : public Policy {
+ public:
+  explicit BatchPolicy(const EstimatorOptions& options) : options_(options) {}
+  PolicyTiming Update(const StereoFrame& frame, StateId new_state, Window& window) override;
+  bool Finish(Window& window) override;
+
+ private:
+  void FreezeOld(Window& window);
+
+  EstimatorOptions options_;
+  std::set<StateId> active_;  ///< states not yet frozen, oldest first
+  int frames_ = 0;
+};
+
+}  // namespace vio

@@ -1,0 +1,69 @@
+#include "vio/estimator/batch_policy.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include <glog/logging.h>
+
+namespace vio {
+namespace {
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+PolicyTiming BatchPolicy::Update(const StereoFrame& frame, StateId new_state, Window& window) {
+  PolicyTiming timing;
+  auto start = std::chrono::steady_clock::now();
+  active_.insert(new_state);
+  for (const StereoObservation& obs : frame.observations) {
+    if (window.HasLandmark(obs.landmark)) window.SetLandmarkConstant(obs.landmark, false);
+  }
+  AddStereoObservations(frame, new_state, options_.model, window);
+  window.RefreshImuFactors(options_.model.reintegrate_bias_threshold);
+  timing.build_ms = MillisecondsSince(start);
+
+  if (++frames_ % std::max(1, options_.batch.batch_solve_every) != 0) return timing;
+  start = std::chrono::steady_clock::now();
+  timing.solver_iterations = window.Solve(options_.solver).iterations;
+  timing.solve_ms = MillisecondsSince(start);
+
+  start = std::chrono::steady_clock::now();
+  FreezeOld(window);
+  timing.marginalize_ms = MillisecondsSince(start);
+  return timing;
+}
+
+// Freezes the states that left the active window and the landmarks no
+// active state sees.
+void BatchPolicy::FreezeOld(Window& window) {
+  while (static_cast<int>(active_.size()) > options_.policy.window_size) {
+    const StateId oldest = *active_.begin();
+    active_.erase(active_.begin());
+    window.SetStateConstant(oldest, true);
+    for (const auto& [id, landmark] : window.landmarks()) {
+      if (!landmark.observed_from.count(oldest)) continue;
+      const bool seen_by_active = std::any_of(landmark.observed_from.begin(), landmark.observed_from.end(),
+                                              [&](StateId s) { return active_.count(s) > 0; });
+      if (!seen_by_active) window.SetLandmarkConstant(id, true);
+    }
+  }
+}
+
+bool BatchPolicy::Finish(Window& window) {
+  for (const auto& [id, state] : window.states()) window.SetStateConstant(id, false);
+  for (const auto& [id, landmark] : window.landmarks()) window.SetLandmarkConstant(id, false);
+  SolverOptions solver = options_.solver;
+  solver.max_iterations = options_.batch.batch_final_iterations;
+  solver.max_solver_time_s = 3600;
+  solver.linear_solver = "sparse";
+  const SolveReport report = window.Solve(solver);
+  LOG(INFO) << "batch: final solve over " << window.states().size() << " states and " << window.landmarks().size()
+            << " landmarks, " << report.iterations << " iterations, cost " << report.initial_cost << " -> "
+            << report.final_cost;
+  return true;
+}
+
+}  // namespace vio

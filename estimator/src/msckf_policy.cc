@@ -1,0 +1,129 @@
+#include "vio/estimator/msckf_policy.h"
+
+#include <algorithm>
+#include <chrono>
+#include <set>
+
+#include "vio/estimator/triangulation.h"
+
+namespace vio {
+namespace {
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+Eigen::Isometry3d BodyPose(const State& s) {
+  Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();
+  T_w_b.linear() = s.q_w_b().toRotationMatrix();
+  T_w_b.translation() = s.p_w_b();
+  return T_w_b;
+}
+
+}  // namespace
+
+MsckfPolicy::MsckfPolicy(const EstimatorOptions& options, int gn_steps) : options_(options), gn_steps_(gn_steps) {
+  CHECK_GE(gn_steps_, 1);
+  CHECK_GE(options_.policy.window_size, 2) << "the MSCKF needs a window of at least 2 states";
+}
+
+PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Window& window) {
+  PolicyTiming timing;
+  auto start = std::chrono::steady_clock::now();
+  for (const StereoObservation& obs : frame.observations) tracks_[obs.landmark].emplace_back(new_state, obs.z_px);
+  const std::vector<StateId> leaving = LeavingStates(window);
+  const std::vector<LandmarkId> added = AddTriangulated(MatureTracks(frame, leaving), window);
+  window.RefreshImuFactors(options_.model.reintegrate_bias_threshold);
+  timing.build_ms = MillisecondsSince(start);
+
+  start = std::chrono::steady_clock::now();
+  SolverOptions solver = options_.solver;
+  solver.max_iterations = gn_steps_;
+  timing.solver_iterations = window.Solve(solver).iterations;
+  timing.solve_ms = MillisecondsSince(start);
+
+  start = std::chrono::steady_clock::now();
+  window.Marginalize(leaving, added);
+  ForgetObservationsOf(leaving);
+  timing.marginalize_ms = MillisecondsSince(start);
+  return timing;
+}
+
+// x_i with i mod 3 == 2 (1-based, oldest first) once the window is over
+// size; the newest state (the current IMU state) never leaves.
+std::vector<StateId> MsckfPolicy::LeavingStates(const Window& window) const {
+  std::vector<StateId> leaving;
+  const int n = static_cast<int>(window.states().size());
+  if (n <= options_.policy.window_size) return leaving;
+  int i = 1;
+  for (const auto& [id, state] : window.states()) {
+    if (i < n && i % 3 == 2) leaving.push_back(id);
+    ++i;
+  }
+  return leaving;
+}
+
+// Tracks not seen in the newest frame, and tracks seen from a leaving state.
+std::vector<LandmarkId> MsckfPolicy::MatureTracks(const StereoFrame& frame, const std::vector<StateId>& leaving) {
+  std::set<LandmarkId> seen_now;
+  for (const StereoObservation& obs : frame.observations) seen_now.insert(obs.landmark);
+  std::vector<LandmarkId> mature;
+  for (auto it = tracks_.begin(); it != tracks_.end();) {
+    const auto& observations = it->second;
+    const bool ended = seen_now.count(it->first) == 0;
+    const bool loses_state = std::any_of(observations.begin(), observations.end(), [&](const Observation& o) {
+      return std::find(leaving.begin(), leaving.end(), o.first) != leaving.end();
+    });
+    const bool long_enough = static_cast<int>(observations.size()) >= options_.msckf.msckf_min_track_length;
+    if (ended && !long_enough) {
+      ++counts_.too_short;
+      it = tracks_.erase(it);
+      continue;
+    }
+    if ((ended || loses_state) && long_enough) mature.push_back(it->first);
+    ++it;
+  }
+  return mature;
+}
+
+// Triangulates each mature track and adds it with all its observations; the
+// track is consumed either way (a later sighting starts a new one).
+std::vector<LandmarkId> MsckfPolicy::AddTriangulated(const std::vector<LandmarkId>& mature, Window& window) {
+  TriangulationOptions triangulation;
+  triangulation.pixel_sigma = options_.model.pixel_sigma;
+  triangulation.max_reprojection_sigma = options_.msckf.msckf_max_reprojection;
+  triangulation.max_position_sigma_m = options_.msckf.msckf_max_landmark_sigma;
+  std::vector<LandmarkId> added;
+  for (LandmarkId id : mature) {
+    const std::vector<Observation> observations = std::move(tracks_.at(id));
+    tracks_.erase(id);
+    std::vector<StereoView> views;
+    for (const auto& [state, z] : observations) views.push_back({BodyPose(window.state(state)), z});
+    const TriangulationResult result = TriangulateMultiView(views, window.stereo(), triangulation);
+    if (!result.p_w) {
+      ++counts_.rejected;
+      continue;
+    }
+    window.AddLandmark(id, *result.p_w);
+    for (const auto& [state, z] : observations) window.AddObservation(state, id, z);
+    added.push_back(id);
+    ++counts_.used;
+  }
+  return added;
+}
+
+// Observations from marginalized states that no used track carried are lost
+// with them (only tracks too short to use).
+void MsckfPolicy::ForgetObservationsOf(const std::vector<StateId>& leaving) {
+  for (auto it = tracks_.begin(); it != tracks_.end();) {
+    auto& observations = it->second;
+    observations.erase(std::remove_if(observations.begin(), observations.end(),
+                                      [&](const Observation& o) {
+                                        return std::find(leaving.begin(), leaving.end(), o.first) != leaving.end();
+                                      }),
+                       observations.end());
+    it = observations.empty() ? tracks_.erase(it) : std::next(it);
+  }
+}
+
+}  // namespace vio

@@ -1,0 +1,78 @@
+#include "vio/estimator/triangulation.h"
+
+#include <Eigen/Eigenvalues>
+#include <glog/logging.h>
+
+#include "vio/estimator/stereo_geometry.h"
+
+namespace vio {
+namespace {
+
+// Residual (z - h) / sigma of one view and its Jacobian with respect to p_w;
+// false when the point is not in front of the camera.
+bool ViewResidual(const StereoView& view, const Eigen::Isometry3d& T_cl_b, const RectifiedStereo& stereo,
+                  const Eigen::Vector3d& p_w, double inv_sigma, double min_depth, Eigen::Vector3d* r,
+                  Eigen::Matrix3d* J) {
+  const Eigen::Isometry3d T_cl_w = T_cl_b * view.T_w_b.inverse();
+  const Eigen::Vector3d p = T_cl_w * p_w;
+  if (p.z() < min_depth) return false;
+  *r = (view.z_px - ProjectRectified(p, stereo)) * inv_sigma;
+  const double f = stereo.f, iz = 1.0 / p.z(), iz2 = iz * iz;
+  Eigen::Matrix3d d_h_d_p;
+  d_h_d_p << f * iz, 0, -f * p.x() * iz2,
+             f * iz, 0, -f * (p.x() - stereo.baseline) * iz2,
+             0, f * iz, -f * p.y() * iz2;
+  *J = -inv_sigma * d_h_d_p * T_cl_w.linear();
+  return true;
+}
+
+// The stereo point of the view with the largest disparity, in world.
+std::optional<Eigen::Vector3d> InitialGuess(const std::vector<StereoView>& views, const RectifiedStereo& stereo) {
+  const StereoView* best = &views.front();
+  for (const StereoView& v : views) {
+    if (v.z_px[0] - v.z_px[1] > best->z_px[0] - best->z_px[1]) best = &v;
+  }
+  const std::optional<Eigen::Vector3d> p_cl = TriangulateRectified(best->z_px, stereo, 1e-3);
+  if (!p_cl) return std::nullopt;
+  return best->T_w_b * stereo.T_b_cl * *p_cl;
+}
+
+}  // namespace
+
+TriangulationResult TriangulateMultiView(const std::vector<StereoView>& views, const RectifiedStereo& stereo,
+                                         const TriangulationOptions& options) {
+  CHECK(!views.empty()) << "triangulation without views";
+  TriangulationResult result;
+  std::optional<Eigen::Vector3d> p_w = InitialGuess(views, stereo);
+  if (!p_w) return {std::nullopt, TriangulationFailure::kNoDisparity};
+  const Eigen::Isometry3d T_cl_b = stereo.T_b_cl.inverse();
+  const double inv_sigma = 1.0 / options.pixel_sigma;
+  Eigen::Matrix3d H;
+  Eigen::Vector3d r, g;
+  Eigen::Matrix3d J;
+  double max_error = 0;
+  for (int it = 0; it <= options.iterations; ++it) {
+    H.setZero();
+    g.setZero();
+    max_error = 0;
+    for (const StereoView& view : views) {
+      if (!ViewResidual(view, T_cl_b, stereo, *p_w, inv_sigma, options.min_depth_m, &r, &J)) {
+        return {std::nullopt, TriangulationFailure::kBehindCamera};
+      }
+      H += J.transpose() * J;
+      g += J.transpose() * r;
+      max_error = std::max(max_error, r.norm());
+    }
+    if (it == options.iterations) break;
+    *p_w -= H.ldlt().solve(g);
+  }
+  if (max_error > options.max_reprojection_sigma) return {std::nullopt, TriangulationFailure::kReprojection};
+  const double min_information = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(H).eigenvalues()[0];
+  if (!(min_information > 0) || 1.0 / std::sqrt(min_information) > options.max_position_sigma_m) {
+    return {std::nullopt, TriangulationFailure::kIllConditioned};
+  }
+  result.p_w = p_w;
+  return result;
+}
+
+}  // namespace vio

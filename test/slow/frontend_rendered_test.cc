@@ -1,0 +1,72 @@
+// Both image front ends end to end on a short synthetic sequence rendered
+// into images (`vio simulate --camera=images`, made in the test's temp dir),
+// then `vio run` with SWF(10): the run completes and the ATE stays small.
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "test_data.h"
+
+namespace vio {
+namespace {
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The number after the first `"key": ` following `after` in a JSON text.
+double JsonNumber(const std::string& json, const std::string& after, const std::string& key) {
+  const size_t start = json.find("\"" + after + "\"");
+  const size_t at = json.find("\"" + key + "\": ", start == std::string::npos ? 0 : start);
+  if (at == std::string::npos) ADD_FAILURE() << "no " << key << " in " << json;
+  return at == std::string::npos ? -1.0 : std::strtod(json.c_str() + at + key.size() + 4, nullptr);
+}
+
+int RunVio(const std::string& arguments, const std::string& log) {
+  const std::string command = std::string(VIO_BINARY) + " " + arguments + " > " + log + " 2>&1";
+  return std::system(command.c_str());
+}
+
+class FrontendRendered : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = test::MakeTempDir("frontend_rendered");
+    ASSERT_EQ(RunVio("simulate --camera=images --duration_s=8 --seed=3 --output_dir=" + dir_ + "/data",
+                  dir_ + "/simulate.log"),
+              0)
+        << "see " << dir_ << "/simulate.log";
+  }
+
+  static void ExpectAteBelow(const std::string& frontend, double bound_m) {
+    const std::string out = dir_ + "/" + frontend;
+    ASSERT_EQ(RunVio("run --dataset=" + dir_ + "/data --output_dir=" + out + " --frontend=" + frontend +
+                      " --policy=swf --window_size=10",
+                  out + ".log"),
+              0)
+        << "see " << out << ".log";
+    const std::string summary = ReadFile(out + "/summary.json");
+    EXPECT_NE(summary.find("\"status\": \"ok\""), std::string::npos) << summary;
+    const double ate = JsonNumber(summary, "ate", "rmse_m");
+    EXPECT_GE(ate, 0.0);
+    EXPECT_LE(ate, bound_m) << frontend;
+    EXPECT_GE(JsonNumber(summary, "features_per_frame", "mean"), 50.0) << frontend;
+    ::testing::Test::RecordProperty(frontend + "_ate_rmse_m", std::to_string(ate));
+  }
+
+  static std::string dir_;
+};
+
+std::string FrontendRendered::dir_;
+
+TEST_F(FrontendRendered, Klt) { ExpectAteBelow("klt", 0.1); }
+
+TEST_F(FrontendRendered, Brisk) { ExpectAteBelow("brisk", 0.1); }
+
+}  // namespace
+}  // namespace vio

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# The paper's experiment (ch. 5, figures 5.2-5.3) on hybrid EuRoC sequences:
+# SWF 5/10/30/50, MSCKF 10, EKF and full batch on V2_01_easy and V1_02_medium
+# (real IMU and motion, simulated stereo features). Prints the Markdown table
+# (ATE, RPE, ms per frame) that `vio sweep` writes, with plots beside it.
+#   tools/paper_table.sh [OUT]     (default OUT: out/paper; resumable)
+# DATA overrides the EuRoC folder (default ../shared/data/euroc), JOBS the parallel runs.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+out="${1:-$root/out/paper}"
+data="${DATA:-$root/../shared/data/euroc}"
+"$root/tools/install_deps.sh"
+"$root/tools/build.sh" >/dev/null
+vio="${BUILD_DIR:-$root/build}/bin/vio"
+datasets=()
+for seq in V2_01_easy V1_02_medium; do
+  [ -d "$data/$seq" ] || { echo "paper_table: $data/$seq not found (set DATA)" >&2; exit 1; }
+  [ -f "$out/hybrid/$seq/mav0/features0/data.csv" ] ||
+    "$vio" simulate --from="$data/$seq" --output_dir="$out/hybrid/$seq" >/dev/null
+  datasets+=("$out/hybrid/$seq")
+done
+status=0
+"$vio" sweep --datasets="$(IFS=,; echo "${datasets[*]}")" \
+  --runs=swf:5,swf:10,swf:30,swf:50,msckf:10,ekf:1,batch:10 \
+  --jobs="${JOBS:-2}" --output_dir="$out/sweep" --config="$root/config/euroc_stereo.yaml" || status=$?
+cat "$out/sweep/results.md"
+exit $status

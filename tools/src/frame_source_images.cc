@@ -1,0 +1,159 @@
+#include "frame_source_images.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include <glog/logging.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "vio/frontend/stereo_frontend.h"
+#include "vio/frontend/track_drawing.h"
+
+namespace vio::tools {
+namespace {
+
+/// Tracks at least this long share the histogram's last bin [frames].
+constexpr int kTrackHistogramBins = 30;
+
+double Percentile(std::vector<int> values, double fraction) {
+  if (values.empty()) return 0.0;
+  const auto k = static_cast<size_t>(fraction * static_cast<double>(values.size() - 1) + 0.5);
+  std::nth_element(values.begin(), values.begin() + static_cast<long>(k), values.end());
+  return values[k];
+}
+
+std::string Number(double x) {
+  std::ostringstream os;
+  os.precision(6);
+  os << x;
+  return os.str();
+}
+
+class ImageFrameSource final : public FrameSource {
+ public:
+  ImageFrameSource(const FrontendOptions& options, const EurocDataset& dataset,
+                   const frontend::StereoRectifier& rectifier)
+      : name_(options.frontend),
+        mav0_(dataset.root + "/mav0"),
+        debug_dir_(options.debug_images),
+        frontend_(frontend::MakeStereoFrontend(options, rectifier)) {
+    PairFrames(dataset);
+    if (!debug_dir_.empty()) std::filesystem::create_directories(debug_dir_);
+  }
+
+  size_t size() const override { return pairs_.size(); }
+  Timestamp time(size_t k) const override { return pairs_[k].t_ns; }
+
+  StereoFrame Frame(size_t k, const Estimator& estimator) override {
+    const Pair& pair = pairs_[k];
+    const auto start = std::chrono::steady_clock::now();
+    const cv::Mat left = Load(0, pair.left), right = Load(1, pair.right);
+    load_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    frontend::FramePrior prior;
+    prior.T_w_b = estimator.PredictBodyPose(pair.t_ns);
+    prior.landmarks = &estimator.window().landmarks();
+    StereoFrame frame = frontend_->Process(pair.t_ns, left, right, prior);
+    if (!debug_dir_.empty()) WriteDebugImage(pair.t_ns, left, right);
+    return frame;
+  }
+
+  std::string ReportJson() const override;
+
+ private:
+  struct Pair {
+    Timestamp t_ns;
+    std::string left, right;  ///< file names under camN/data/
+  };
+
+  void PairFrames(const EurocDataset& dataset) {
+    std::map<Timestamp, std::string> right;
+    for (const CameraFrame& f : dataset.frames[1]) right[f.t_ns] = f.filename;
+    for (const CameraFrame& f : dataset.frames[0]) {
+      const auto it = right.find(f.t_ns);
+      if (it == right.end()) {
+        ++unpaired_;
+        continue;
+      }
+      pairs_.push_back(Pair{f.t_ns, f.filename, it->second});
+    }
+    if (unpaired_ > 0) LOG(WARNING) << mav0_ << ": " << unpaired_ << " cam0 frames have no cam1 image; skipped";
+  }
+
+  cv::Mat Load(int camera, const std::string& filename) const {
+    const std::string path = mav0_ + "/cam" + std::to_string(camera) + "/data/" + filename;
+    cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    if (image.empty()) throw std::runtime_error(path + ": cannot read the image");
+    return image;
+  }
+
+  void WriteDebugImage(Timestamp t_ns, const cv::Mat& left, const cv::Mat& right) {
+    const std::string path = debug_dir_ + "/" + std::to_string(t_ns) + ".png";
+    if (!cv::imwrite(path, drawer_.Draw(left, right, frontend_->features()))) {
+      throw std::runtime_error(path + ": cannot write the debug image");
+    }
+  }
+
+  std::string name_;
+  std::string mav0_;
+  std::string debug_dir_;
+  std::unique_ptr<frontend::StereoFrontend> frontend_;
+  frontend::TrackDrawer drawer_;
+  std::vector<Pair> pairs_;
+  int unpaired_ = 0;
+  double load_ms_ = 0;
+};
+
+std::string TrackLengthJson(const frontend::FeatureTracks& tracks) {
+  const std::vector<int> lengths = tracks.TrackLengths();
+  std::vector<int> histogram(kTrackHistogramBins, 0);
+  for (int n : lengths) ++histogram[static_cast<size_t>(std::min(n, kTrackHistogramBins) - 1)];
+  std::ostringstream os;
+  os << "{\"tracks\": " << lengths.size() << ", \"median\": " << Number(Percentile(lengths, 0.5))
+     << ", \"p90\": " << Number(Percentile(lengths, 0.9)) << ", \"max\": "
+     << (lengths.empty() ? 0 : *std::max_element(lengths.begin(), lengths.end())) << ", \"histogram\": [";
+  for (size_t i = 0; i < histogram.size(); ++i) os << (i ? ", " : "") << histogram[i];
+  os << "]}";
+  return os.str();
+}
+
+std::string ImageFrameSource::ReportJson() const {
+  const frontend::FrontendStats& s = frontend_->stats();
+  const double frames = std::max<double>(1.0, static_cast<double>(s.frames));
+  const std::vector<int>& per_frame = s.observations_per_frame;
+  double sum = 0;
+  for (int n : per_frame) sum += n;
+  std::ostringstream os;
+  os << "{\"source\": \"" << name_ << "\", \"frames\": " << s.frames << ", \"unpaired_frames\": " << unpaired_
+     << ", \"features_per_frame\": {\"mean\": " << Number(sum / frames) << ", \"min\": "
+     << (per_frame.empty() ? 0 : *std::min_element(per_frame.begin(), per_frame.end())) << ", \"max\": "
+     << (per_frame.empty() ? 0 : *std::max_element(per_frame.begin(), per_frame.end())) << "}"
+     << ", \"stereo_candidates\": " << s.stereo_candidates << ", \"stereo_inliers\": " << s.stereo_inliers
+     << ", \"stereo_inlier_ratio\": "
+     << Number(s.stereo_candidates ? static_cast<double>(s.stereo_inliers) / s.stereo_candidates : 0.0)
+     << ", \"stereo_row_difference_median_px\": " << Number(s.MedianRowDifferencePx())
+     << ", \"temporal_matches\": " << s.temporal_matches << ", \"rejected_reprojection\": " << s.rejected_reprojection
+     << ", \"new_tracks\": " << s.new_tracks << ", \"track_length\": " << TrackLengthJson(frontend_->tracks())
+     << ", \"stage_ms\": {\"load\": " << Number(load_ms_ / frames) << ", \"detect\": "
+     << Number(s.time.detect_ms / frames) << ", \"stereo_match\": " << Number(s.time.stereo_ms / frames)
+     << ", \"temporal_match\": " << Number(s.time.temporal_ms / frames) << ", \"reject\": "
+     << Number(s.time.reject_ms / frames) << ", \"frontend\": " << Number(s.time.total() / frames) << "}}";
+  return os.str();
+}
+
+}  // namespace
+
+std::unique_ptr<FrameSource> MakeImageFrameSource(const FrontendOptions& options, const EurocDataset& dataset,
+                                                  const frontend::StereoRectifier& rectifier) {
+  if (!dataset.has_images) {
+    throw std::runtime_error(dataset.root + ": the '" + options.frontend +
+                             "' front end needs the images of mav0/cam0/data and mav0/cam1/data, and there are none "
+                             "(render some with `vio simulate --camera=images`, or use --frontend=features)");
+  }
+  return std::make_unique<ImageFrameSource>(options, dataset, rectifier);
+}
+
+}  // namespace vio::tools
