@@ -5,14 +5,6 @@
 #include <glog/logging.h>
 
 namespace vio {
-namespace {
-
-double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
-
 Estimator::Estimator(const EstimatorOptions& options, const ImuCalibration& imu, const RectifiedStereo& stereo)
     : options_(options), imu_calibration_(imu), window_(options.model, stereo), policy_(MakePolicy(options)) {
   imu_calibration_.gyro_noise_density *= options.model.imu_noise_scale;
@@ -147,15 +139,8 @@ FrameEstimate Estimator::EstimateOf(const State& s) const {
 }
 
 FrameEstimate Estimator::Estimate(const StereoFrame& frame) const {
-  const State& s = window_.state(last_state_);
-  FrameEstimate e;
+  FrameEstimate e = EstimateOf(window_.state(last_state_));
   e.t_ns = frame.t_ns;
-  e.initialized = true;
-  e.p_w_b = s.p_w_b();
-  e.q_w_b = s.q_w_b();
-  e.v_w_b = s.v_w_b();
-  e.gyro_bias = s.gyro_bias();
-  e.accel_bias = s.accel_bias();
   e.num_states = static_cast<int>(window_.states().size());
   e.num_landmarks = static_cast<int>(window_.landmarks().size());
   e.num_observations = static_cast<int>(frame.observations.size());

@@ -4,14 +4,6 @@
 #include <iterator>
 
 namespace vio {
-namespace {
-
-double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
-
 PolicyTiming KeyframePolicy::Update(const StereoFrame& frame, StateId new_state, Window& window) {
   PolicyTiming timing;
   auto start = std::chrono::steady_clock::now();

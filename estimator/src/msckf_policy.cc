@@ -9,10 +9,6 @@
 namespace vio {
 namespace {
 
-double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
 Eigen::Isometry3d BodyPose(const State& s) {
   Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();
   T_w_b.linear() = s.q_w_b().toRotationMatrix();

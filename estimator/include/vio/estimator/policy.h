@@ -4,6 +4,7 @@
 // Gauss-Newton steps to take, and what to marginalize or drop. Policies are
 // functions over a Window; they hold no estimation state of their own beyond
 // bookkeeping (e.g. which tracks are pending).
+#include <chrono>
 #include <memory>
 
 #include "vio/estimator/estimator_options.h"
@@ -35,6 +36,11 @@ class Policy {
 std::unique_ptr<Policy> MakePolicy(const EstimatorOptions& options);
 
 // ---- building blocks shared by the policies ------------------------------
+
+/// Wall time since `start` [ms].
+inline double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
 
 /// Adds the frame's observations: of landmarks already in the window, and of
 /// new landmarks stereo-triangulated from `state`'s current pose (those with
