@@ -5,22 +5,13 @@
 
 namespace vio {
 PolicyTiming KeyframePolicy::Update(const StereoFrame& frame, StateId new_state, Window& window) {
-  PolicyTiming timing;
-  auto start = std::chrono::steady_clock::now();
   if (IsNewKeyframe(frame, window)) {
     keyframes_.insert(new_state);
     last_keyframe_landmarks_.clear();
     for (const StereoObservation& obs : frame.observations) last_keyframe_landmarks_.insert(obs.landmark);
   }
-  AddStereoObservations(frame, new_state, options_.model, window);
-  window.RefreshImuFactors(options_.model.reintegrate_bias_threshold);
-  timing.build_ms = MillisecondsSince(start);
-
-  start = std::chrono::steady_clock::now();
-  timing.solver_iterations = window.Solve(options_.solver).iterations;
-  timing.solve_ms = MillisecondsSince(start);
-
-  start = std::chrono::steady_clock::now();
+  PolicyTiming timing = AddFrameAndSolve(frame, new_state, options_, window);
+  const auto start = std::chrono::steady_clock::now();
   SlideTemporalWindow(window);
   if (static_cast<int>(keyframes_.size()) > options_.policy.window_size) MarginalizeOldestKeyframe(window);
   timing.marginalize_ms = MillisecondsSince(start);
@@ -46,7 +37,7 @@ void KeyframePolicy::SlideTemporalWindow(Window& window) {
   const StateId id = leaving->first;
   if (keyframes_.count(id) || leaving == window.states().begin()) return;
   if (window.IsInPrior(id)) {
-    Marginalize(id, window);
+    MarginalizeStateAndItsLandmarks(id, options_.policy, window);
   } else {
     window.DropState(id);
   }
@@ -55,16 +46,7 @@ void KeyframePolicy::SlideTemporalWindow(Window& window) {
 void KeyframePolicy::MarginalizeOldestKeyframe(Window& window) {
   const StateId oldest = *keyframes_.begin();
   keyframes_.erase(keyframes_.begin());
-  Marginalize(oldest, window);
-}
-
-// As SWF marginalizes its oldest state (swf_landmarks decides the landmarks).
-void KeyframePolicy::Marginalize(StateId id, Window& window) const {
-  const std::vector<StateId> leaving = {id};
-  const std::vector<LandmarkId> landmarks = options_.policy.swf_landmarks == "keep"
-                                                ? LandmarksOnlySeenFrom(window, leaving)
-                                                : LandmarksSeenFrom(window, leaving);
-  window.Marginalize(leaving, landmarks);
+  MarginalizeStateAndItsLandmarks(oldest, options_.policy, window);
 }
 
 }  // namespace vio

@@ -48,6 +48,25 @@ int AddStereoObservations(const StereoFrame& frame, StateId state_id, const Mode
   return added;
 }
 
+PolicyTiming AddFrameAndSolve(const StereoFrame& frame, StateId state, const EstimatorOptions& options,
+                              Window& window) {
+  PolicyTiming timing;
+  auto start = std::chrono::steady_clock::now();
+  AddStereoObservations(frame, state, options.model, window);
+  window.RefreshImuFactors(options.model.reintegrate_bias_threshold);
+  timing.build_ms = MillisecondsSince(start);
+  start = std::chrono::steady_clock::now();
+  timing.solver_iterations = window.Solve(options.solver).iterations;
+  timing.solve_ms = MillisecondsSince(start);
+  return timing;
+}
+
+void MarginalizeStateAndItsLandmarks(StateId state, const PolicyOptions& options, Window& window) {
+  const std::vector<StateId> leaving = {state};
+  window.Marginalize(leaving, options.swf_landmarks == "keep" ? LandmarksOnlySeenFrom(window, leaving)
+                                                               : LandmarksSeenFrom(window, leaving));
+}
+
 std::vector<LandmarkId> LandmarksOnlySeenFrom(const Window& window, const std::vector<StateId>& leaving) {
   std::vector<LandmarkId> out;
   for (const auto& [id, landmark] : window.landmarks()) {

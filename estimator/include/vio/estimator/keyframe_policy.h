@@ -21,7 +21,6 @@ class KeyframePolicy final : public Policy {
   bool IsNewKeyframe(const StereoFrame& frame, const Window& window) const;
   void SlideTemporalWindow(Window& window);
   void MarginalizeOldestKeyframe(Window& window);
-  void Marginalize(StateId id, Window& window) const;
 
   EstimatorOptions options_;
   std::set<StateId> keyframes_;

@@ -48,6 +48,16 @@ inline double MillisecondsSince(std::chrono::steady_clock::time_point start) {
 /// Returns the number of new landmarks.
 int AddStereoObservations(const StereoFrame& frame, StateId state, const ModelOptions& model, Window& window);
 
+/// The sliding-window frame step: the frame's observations in (new
+/// landmarks stereo-triangulated), IMU factors refreshed, then Gauss-Newton
+/// steps; returns the build and solve timings.
+PolicyTiming AddFrameAndSolve(const StereoFrame& frame, StateId state, const EstimatorOptions& options,
+                              Window& window);
+
+/// Marginalizes one state with the landmarks `swf_landmarks` names: those
+/// only it sees (keep) or every one it sees (marginalize).
+void MarginalizeStateAndItsLandmarks(StateId state, const PolicyOptions& options, Window& window);
+
 /// Landmarks observed from no state other than those in `leaving`.
 std::vector<LandmarkId> LandmarksOnlySeenFrom(const Window& window, const std::vector<StateId>& leaving);
 

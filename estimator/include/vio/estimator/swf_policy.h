@@ -15,8 +15,6 @@ class SwfPolicy final : public Policy {
   PolicyTiming Update(const StereoFrame& frame, StateId new_state, Window& window) override;
 
  private:
-  void MarginalizeOldest(Window& window) const;
-
   EstimatorOptions options_;
 };
 
