@@ -50,7 +50,7 @@ bool BatchPolicy::Finish(Window& window) {
   SolverOptions solver = options_.solver;
   solver.max_iterations = options_.batch.batch_final_iterations;
   solver.max_solver_time_s = 3600;
-  solver.linear_solver = "sparse";
+  solver.linear_solver = "sparse_full";
   const SolveReport report = window.Solve(solver);
   LOG(INFO) << "batch: final solve over " << window.states().size() << " states and " << window.landmarks().size()
             << " landmarks, " << report.iterations << " iterations, cost " << report.initial_cost << " -> "

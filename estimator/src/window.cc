@@ -144,21 +144,37 @@ std::shared_ptr<ceres::ParameterBlockOrdering> Window::SchurOrdering() const {
   return ordering;
 }
 
+// For sparse Cholesky of the whole normal equations: the states first, then
+// the landmarks. A whole sequence sees few landmarks many times, so
+// eliminating the states (a chain, little fill) leaves a small dense system
+// over the landmarks; eliminating the landmarks first would leave a large,
+// nearly dense one over the states.
+std::shared_ptr<ceres::ParameterBlockOrdering> Window::StatesFirstOrdering() const {
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (const auto& [id, s] : states_) {
+    ordering->AddElementToGroup(const_cast<double*>(s.pose), 0);
+    ordering->AddElementToGroup(const_cast<double*>(s.speed_bias), 0);
+  }
+  for (const auto& [id, landmark] : landmarks_) ordering->AddElementToGroup(const_cast<double*>(landmark.p_w), 1);
+  return ordering;
+}
+
 SolveReport Window::Solve(const SolverOptions& options) {
   ceres::Solver::Options solver;
-  solver.linear_solver_ordering = SchurOrdering();
+  solver.linear_solver_ordering = options.linear_solver == "sparse_full" ? StatesFirstOrdering() : SchurOrdering();
   // With nothing to eliminate (every landmark tied into a prior, as in
   // EKF-SLAM) the Schur complement only adds overhead.
-  const bool eliminable = solver.linear_solver_ordering->GroupSize(0) > 0;
+  const bool eliminable =
+      options.linear_solver != "sparse_full" && solver.linear_solver_ordering->GroupSize(0) > 0;
   if (options.linear_solver == "iterative") {
     solver.linear_solver_type = eliminable ? ceres::ITERATIVE_SCHUR : ceres::CGNR;
     solver.preconditioner_type = eliminable ? ceres::SCHUR_JACOBI : ceres::JACOBI;
-  } else if (options.linear_solver == "sparse") {
+  } else if (options.linear_solver == "sparse" || options.linear_solver == "sparse_full") {
     solver.linear_solver_type = eliminable ? ceres::SPARSE_SCHUR : ceres::SPARSE_NORMAL_CHOLESKY;
   } else {
     solver.linear_solver_type = eliminable ? ceres::DENSE_SCHUR : ceres::DENSE_NORMAL_CHOLESKY;
   }
-  if (!eliminable) solver.linear_solver_ordering.reset();
+  if (!eliminable && options.linear_solver != "sparse_full") solver.linear_solver_ordering.reset();
   solver.max_num_iterations = options.max_iterations;
   solver.max_solver_time_in_seconds = options.max_solver_time_s;
   solver.function_tolerance = options.function_tolerance;

@@ -165,10 +165,13 @@ TEST(FrontendReal, FlightMotionMatchesGroundTruth) {
         Nearest(truth, poses.front().t_s).T_w_b.inverse() * Nearest(truth, poses.back().t_s).T_w_b;
     const Eigen::Isometry3d error = motion_gt.inverse() * motion;
     ASSERT_GT(motion_gt.translation().norm(), 0.15);
-    // Both front ends land 2.2 cm / 1.2 deg from ground truth, within 1 mm of
-    // each other: the residual is not the front end's (see README "Front ends").
+    // Rotation: the 1 degree (0.3-0.4 deg measured, with the biases
+    // derived from the pose-only ground truth). Translation: 2.2-2.3 cm
+    // measured against the 2 cm; vision alone gives the same, and
+    // the residual fits a 10.6 cm lever arm along body y between the camera
+    // calibration and the ground-truth body frame (README "Front ends").
     EXPECT_LT(error.translation().norm(), 0.025) << name;
-    EXPECT_LT(Eigen::AngleAxisd(error.rotation()).angle(), 1.5 * M_PI / 180.0) << name;
+    EXPECT_LT(Eigen::AngleAxisd(error.rotation()).angle(), 1.0 * M_PI / 180.0) << name;
   }
 }
 

@@ -95,6 +95,7 @@ std::vector<GroundTruthState> ReadTumTrajectory(const std::string& path) {
     order.Check(reader, state.t_ns);
     state.p_w_b = ReadVector3(reader, 1);
     state.q_w_b = ReadUnitQuaternion(reader, /*w_column=*/7, /*x_column=*/4);
+    state.has_velocity_and_biases = false;
     poses.push_back(state);
   }
   reader.RequireRows();

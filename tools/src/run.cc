@@ -16,6 +16,7 @@
 #include "vio/tools/euroc_dataset.h"
 #include "vio/tools/progress.h"
 #include "vio/tools/frame_source.h"
+#include "vio/tools/groundtruth_init.h"
 
 namespace vio::tools {
 namespace {
@@ -42,23 +43,6 @@ EurocDataset ReadRunDataset(const RunRequest& request) {
 
 // Ground truth at t_ns (linear in position, velocity and biases; slerp in
 // rotation), or nothing outside its span.
-std::optional<InitialState> GroundTruthAt(const std::vector<GroundTruthState>& gt, Timestamp t_ns) {
-  auto it = std::lower_bound(gt.begin(), gt.end(), t_ns,
-                             [](const GroundTruthState& s, Timestamp t) { return s.t_ns < t; });
-  if (it == gt.end() || (it == gt.begin() && it->t_ns != t_ns)) return std::nullopt;
-  const GroundTruthState& b = *it;
-  const GroundTruthState& a = it == gt.begin() ? b : *(it - 1);
-  const double s = b.t_ns == a.t_ns ? 0.0 : static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
-  InitialState state;
-  state.t_ns = t_ns;
-  state.p_w_b = (1 - s) * a.p_w_b + s * b.p_w_b;
-  state.q_w_b = a.q_w_b.slerp(s, b.q_w_b);
-  state.v_w_b = (1 - s) * a.v_w_b + s * b.v_w_b;
-  state.gyro_bias = (1 - s) * a.gyro_bias + s * b.gyro_bias;
-  state.accel_bias = (1 - s) * a.accel_bias + s * b.accel_bias;
-  return state;
-}
-
 bool Diverged(const FrameEstimate& e) {
   return !e.p_w_b.allFinite() || !e.q_w_b.coeffs().allFinite() || e.p_w_b.norm() > 1e4 || e.v_w_b.norm() > 100;
 }
@@ -87,7 +71,9 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
   for (size_t k = 0; k < source.size(); ++k) {
     if (!FeedImuUpTo(dataset.imu, source.time(k), &next_imu, &estimator)) break;
     if (init_from_gt && result->frames_estimated == 0) {
-      const std::optional<InitialState> gt = GroundTruthAt(dataset.groundtruth, source.time(k));
+      const InitOptions& init = request.config.estimator.init;
+      const std::optional<InitialState> gt = GroundTruthInitialState(
+          dataset.groundtruth, dataset.imu, source.time(k), request.config.estimator.model.gravity, init.static_window_s);
       if (!gt) continue;  // frame before the ground-truth span: no state to start from
       estimator.SetInitialState(*gt);
     }

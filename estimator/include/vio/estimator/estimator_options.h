@@ -76,15 +76,16 @@ struct SolverOptions {
   double max_solver_time_s = 1.0;   ///< wall-time bound per solve [s] (a run that hits it is not reproducible)
   double function_tolerance = 1e-6;  ///< relative cost decrease that counts as converged []
   int num_threads = 1;            ///< Ceres threads [count]
-  std::string linear_solver = "dense";  ///< reduced system: dense | sparse (SuiteSparse) | iterative (PCG)
+  std::string linear_solver = "dense";  ///< dense | sparse (Schur-reduced) | sparse_full (whole system) | iterative
 
   template <class V>
   void Visit(V& v) {
     v("max_iterations", max_iterations, "Gauss-Newton iterations per frame [count]");
     v("linear_solver", linear_solver,
-      "reduced (Schur) system: dense Cholesky, sparse Cholesky (large windows) or iterative "
-      "(preconditioned conjugate gradients: batch-sized problems)",
-      {"dense", "sparse", "iterative"});
+      "dense or sparse Cholesky of the Schur-reduced system (sparse: large windows), sparse_full (sparse Cholesky "
+      "of the whole system, states eliminated before landmarks: whole sequences, batch's final solve) or iterative "
+      "(preconditioned conjugate gradients on the reduced system)",
+      {"dense", "sparse", "sparse_full", "iterative"});
     v("max_solver_time_s", max_solver_time_s,
       "wall-time bound of one solve [s]; a safety net: a run that hits it is not reproducible");
     v("function_tolerance", function_tolerance, "relative cost decrease that counts as converged []");
@@ -118,7 +119,7 @@ struct ModelOptions {
 /// How the first state is found.
 struct InitOptions {
   std::string init = "static";          ///< static (IMU stillness) or groundtruth
-  double static_window_s = 1.0;         ///< IMU span averaged for gravity and gyro bias [s]
+  double static_window_s = 1.0;         ///< IMU span averaged for the initial biases (static: also gravity) [s]
   double static_max_gyro_std = 0.05;    ///< stillness: largest gyro standard deviation [rad/s]
   double static_max_accel_std = 0.8;    ///< stillness: largest accel standard deviation [m/s^2]
   double prior_position_sigma = 1e-3;   ///< first-pose prior on position [m]
@@ -131,7 +132,7 @@ struct InitOptions {
   template <class V>
   void Visit(V& v) {
     v("init", init, "initialization: static (IMU stillness) or groundtruth", {"static", "groundtruth"});
-    v("static_window_s", static_window_s, "IMU span averaged for gravity and gyro bias [s]");
+    v("static_window_s", static_window_s, "IMU span averaged for the initial biases (static: also gravity; groundtruth: either side of the start) [s]");
     v("static_max_gyro_std", static_max_gyro_std, "stillness: largest gyro standard deviation [rad/s]");
     v("static_max_accel_std", static_max_accel_std, "stillness: largest accel standard deviation [m/s^2]");
     v("prior_position_sigma", prior_position_sigma, "first-pose prior on position [m]");

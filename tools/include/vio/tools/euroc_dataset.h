@@ -39,6 +39,7 @@ struct GroundTruthState {
   Eigen::Vector3d v_w_b = Eigen::Vector3d::Zero();              ///< [m/s]; zero from TUM text
   Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();          ///< [rad/s]; zero from TUM text
   Eigen::Vector3d accel_bias = Eigen::Vector3d::Zero();         ///< [m/s^2]; zero from TUM text
+  bool has_velocity_and_biases = true;                          ///< false when read from TUM text (poses only)
 };
 
 /// One row of camN/data.csv: the frame stamp and the image file it names.
