@@ -4,6 +4,8 @@
 #include <chrono>
 #include <set>
 
+#include <glog/logging.h>
+
 #include "vio/estimator/triangulation.h"
 
 namespace vio {
@@ -35,8 +37,11 @@ PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
   start = std::chrono::steady_clock::now();
   SolverOptions solver = options_.solver;
   solver.max_iterations = gn_steps_;
-  timing.solver_iterations = window.Solve(solver).iterations;
+  const SolveReport report = window.Solve(solver);
+  timing.solver_iterations = report.iterations;
   timing.solve_ms = MillisecondsSince(start);
+  VLOG(1) << "msckf t=" << frame.t_ns << ": " << added.size() << " landmarks, " << leaving.size()
+          << " states leaving, cost " << report.initial_cost << " -> " << report.final_cost;
 
   start = std::chrono::steady_clock::now();
   window.Marginalize(leaving, added);

@@ -159,22 +159,31 @@ std::shared_ptr<ceres::ParameterBlockOrdering> Window::StatesFirstOrdering() con
   return ordering;
 }
 
-SolveReport Window::Solve(const SolverOptions& options) {
-  ceres::Solver::Options solver;
-  solver.linear_solver_ordering = options.linear_solver == "sparse_full" ? StatesFirstOrdering() : SchurOrdering();
+// Ceres' linear solver and elimination ordering for `linear_solver`.
+void Window::ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const {
+  if (linear_solver == "sparse_full") {
+    solver->linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    solver->linear_solver_ordering = StatesFirstOrdering();
+    return;
+  }
+  solver->linear_solver_ordering = SchurOrdering();
   // With nothing to eliminate (every landmark tied into a prior, as in
   // EKF-SLAM) the Schur complement only adds overhead.
-  const bool eliminable =
-      options.linear_solver != "sparse_full" && solver.linear_solver_ordering->GroupSize(0) > 0;
-  if (options.linear_solver == "iterative") {
-    solver.linear_solver_type = eliminable ? ceres::ITERATIVE_SCHUR : ceres::CGNR;
-    solver.preconditioner_type = eliminable ? ceres::SCHUR_JACOBI : ceres::JACOBI;
-  } else if (options.linear_solver == "sparse" || options.linear_solver == "sparse_full") {
-    solver.linear_solver_type = eliminable ? ceres::SPARSE_SCHUR : ceres::SPARSE_NORMAL_CHOLESKY;
+  const bool eliminable = solver->linear_solver_ordering->GroupSize(0) > 0;
+  if (!eliminable) solver->linear_solver_ordering.reset();
+  if (linear_solver == "iterative") {
+    solver->linear_solver_type = eliminable ? ceres::ITERATIVE_SCHUR : ceres::CGNR;
+    solver->preconditioner_type = eliminable ? ceres::SCHUR_JACOBI : ceres::JACOBI;
+  } else if (linear_solver == "sparse") {
+    solver->linear_solver_type = eliminable ? ceres::SPARSE_SCHUR : ceres::SPARSE_NORMAL_CHOLESKY;
   } else {
-    solver.linear_solver_type = eliminable ? ceres::DENSE_SCHUR : ceres::DENSE_NORMAL_CHOLESKY;
+    solver->linear_solver_type = eliminable ? ceres::DENSE_SCHUR : ceres::DENSE_NORMAL_CHOLESKY;
   }
-  if (!eliminable && options.linear_solver != "sparse_full") solver.linear_solver_ordering.reset();
+}
+
+SolveReport Window::Solve(const SolverOptions& options) {
+  ceres::Solver::Options solver;
+  ChooseLinearSolver(options.linear_solver, &solver);
   solver.max_num_iterations = options.max_iterations;
   solver.max_solver_time_in_seconds = options.max_solver_time_s;
   solver.function_tolerance = options.function_tolerance;

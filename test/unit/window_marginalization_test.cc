@@ -99,7 +99,9 @@ void ExpectMarginalizingAtTheOptimumKeepsIt(bool keep_landmarks) {
   // Either way the leaving state saw landmarks; with keep_landmarks those
   // others still see stay, tied to the rest by the prior.
   ASSERT_FALSE(LandmarksSeenFrom(window, leaving).empty());
-  if (!keep_landmarks) ASSERT_FALSE(landmarks.empty());
+  if (!keep_landmarks) {
+    ASSERT_FALSE(landmarks.empty());
+  }
   const size_t landmarks_before = window.landmarks().size();
   window.Marginalize(leaving, landmarks);
   EXPECT_EQ(window.states().size(), static_cast<size_t>(kFrames - 1));

@@ -65,8 +65,9 @@ class Estimator {
  private:
   struct Prediction {
     ImuPreintegration preintegration;
-    Eigen::Vector3d p_w_b, v_w_b;
-    Eigen::Quaterniond q_w_b;
+    Eigen::Vector3d p_w_b = Eigen::Vector3d::Zero();
+    Eigen::Vector3d v_w_b = Eigen::Vector3d::Zero();
+    Eigen::Quaterniond q_w_b = Eigen::Quaterniond::Identity();
   };
   Prediction Predict(Timestamp t_ns) const;
   bool Initialize(const StereoFrame& frame);

@@ -136,6 +136,7 @@ class Window {
   void AddImuResidual(ImuEdge& edge);
   std::shared_ptr<ceres::ParameterBlockOrdering> SchurOrdering() const;
   std::shared_ptr<ceres::ParameterBlockOrdering> StatesFirstOrdering() const;
+  void ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const;
   void ForgetResidualsOf(const std::set<const double*>& removed_blocks);
   void RemoveStateBookkeeping(StateId id);
 
