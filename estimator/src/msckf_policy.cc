@@ -64,50 +64,82 @@ std::vector<StateId> MsckfPolicy::LeavingStates(const Window& window) const {
   return leaving;
 }
 
-// Tracks not seen in the newest frame, and tracks seen from a leaving state.
-std::vector<LandmarkId> MsckfPolicy::MatureTracks(const StereoFrame& frame, const std::vector<StateId>& leaving) {
+// Tracks not seen in the newest frame give all their observations. Tracks
+// seen from a leaving state give all of them too and restart (whole_track),
+// or only their views from the leaving states when seen from every one of
+// them, and go on (leaving_views).
+std::vector<MsckfPolicy::TrackUpdate> MsckfPolicy::MatureTracks(const StereoFrame& frame,
+                                                                const std::vector<StateId>& leaving) {
   std::set<LandmarkId> seen_now;
   for (const StereoObservation& obs : frame.observations) seen_now.insert(obs.landmark);
-  std::vector<LandmarkId> mature;
+  const bool whole_track = options_.msckf.msckf_leaving_update == "whole_track";
+  std::vector<TrackUpdate> updates;
   for (auto it = tracks_.begin(); it != tracks_.end();) {
-    const auto& observations = it->second;
+    std::vector<Observation>& observations = it->second;
     const bool ended = seen_now.count(it->first) == 0;
+    const bool long_enough = static_cast<int>(observations.size()) >= options_.msckf.msckf_min_track_length;
     const bool loses_state = std::any_of(observations.begin(), observations.end(), [&](const Observation& o) {
       return std::find(leaving.begin(), leaving.end(), o.first) != leaving.end();
     });
-    const bool long_enough = static_cast<int>(observations.size()) >= options_.msckf.msckf_min_track_length;
-    if (ended && !long_enough) {
-      ++counts_.too_short;
-      it = tracks_.erase(it);
-      continue;
+    if (ended || (whole_track && loses_state)) {
+      if (long_enough) {
+        updates.push_back({it->first, std::move(observations)});
+      } else if (ended) {
+        ++counts_.too_short;
+      }
+      if (long_enough || ended) {
+        it = tracks_.erase(it);
+        continue;
+      }
+    } else if (loses_state) {
+      if (std::optional<TrackUpdate> update = LeavingViews(observations, it->first, leaving)) {
+        updates.push_back(std::move(*update));
+      }
     }
-    if ((ended || loses_state) && long_enough) mature.push_back(it->first);
     ++it;
   }
-  return mature;
+  return updates;
 }
 
-// Triangulates each mature track and adds it with all its observations; the
-// track is consumed either way (a later sighting starts a new one).
-std::vector<LandmarkId> MsckfPolicy::AddTriangulated(const std::vector<LandmarkId>& mature, Window& window) {
+// Paper Algorithm 4, line 12: the track's views from the leaving states when
+// it was seen from each of them (removed from the track).
+std::optional<MsckfPolicy::TrackUpdate> MsckfPolicy::LeavingViews(std::vector<Observation>& track, LandmarkId id,
+                                                                  const std::vector<StateId>& leaving) const {
+  TrackUpdate update{id, {}};
+  for (const Observation& o : track) {
+    if (std::find(leaving.begin(), leaving.end(), o.first) != leaving.end()) update.observations.push_back(o);
+  }
+  if (update.observations.size() != leaving.size() ||
+      static_cast<int>(update.observations.size()) < options_.msckf.msckf_min_track_length) {
+    return std::nullopt;
+  }
+  track.erase(std::remove_if(track.begin(), track.end(),
+                             [&](const Observation& o) {
+                               return std::find(leaving.begin(), leaving.end(), o.first) != leaving.end();
+                             }),
+              track.end());
+  return update;
+}
+
+// Triangulates each update's observations and adds the landmark with them;
+// rejected ones are counted and their observations dropped.
+std::vector<LandmarkId> MsckfPolicy::AddTriangulated(const std::vector<TrackUpdate>& updates, Window& window) {
   TriangulationOptions triangulation;
   triangulation.pixel_sigma = options_.model.pixel_sigma;
   triangulation.max_reprojection_sigma = options_.msckf.msckf_max_reprojection;
   triangulation.max_position_sigma_m = options_.msckf.msckf_max_landmark_sigma;
   std::vector<LandmarkId> added;
-  for (LandmarkId id : mature) {
-    const std::vector<Observation> observations = std::move(tracks_.at(id));
-    tracks_.erase(id);
+  for (const TrackUpdate& update : updates) {
     std::vector<StereoView> views;
-    for (const auto& [state, z] : observations) views.push_back({BodyPose(window.state(state)), z});
+    for (const auto& [state, z] : update.observations) views.push_back({BodyPose(window.state(state)), z});
     const TriangulationResult result = TriangulateMultiView(views, window.stereo(), triangulation);
     if (!result.p_w) {
       ++counts_.rejected;
       continue;
     }
-    window.AddLandmark(id, *result.p_w);
-    for (const auto& [state, z] : observations) window.AddObservation(state, id, z);
-    added.push_back(id);
+    window.AddLandmark(update.id, *result.p_w);
+    for (const auto& [state, z] : update.observations) window.AddObservation(state, update.id, z);
+    added.push_back(update.id);
     ++counts_.used;
   }
   return added;

@@ -60,6 +60,21 @@ INSTANTIATE_TEST_SUITE_P(Policies, EveryPolicy,
                                            std::make_pair("keyframe", 0.05)),
                          [](const auto& info) { return info.param.first; });
 
+// The MSCKF's other use of tracks seen from leaving states (whole tracks,
+// restarted) runs the flight as well.
+TEST(RunSynthetic, MsckfWithWholeTracksTracksTheSyntheticFlight) {
+  RunRequest request;
+  request.dataset_dir = SyntheticDataset();
+  request.output_dir = test::MakeTempDir("run_msckf_whole_track");
+  request.show_progress = false;
+  request.config.estimator.policy.policy = "msckf";
+  request.config.estimator.msckf.msckf_leaving_update = "whole_track";
+  const RunResult result = RunDataset(request);
+  EXPECT_EQ(result.status, "ok");
+  ASSERT_TRUE(result.evaluation.has_value());
+  EXPECT_LE(result.evaluation->ate.rmse_m, 0.05);
+}
+
 TEST(RunSynthetic, SwfTracksTheSyntheticFlight) {
   const std::string out = test::MakeTempDir("run_synthetic_out");
   const RunResult result = RunOnSynthetic(out);

@@ -43,10 +43,19 @@ struct MsckfOptions {
   int msckf_min_track_length = 2;         ///< observations a track needs to be used [frames]
   double msckf_max_reprojection = 5.0;    ///< triangulation: largest whitened reprojection error [sigma]
   double msckf_max_landmark_sigma = 2.0;  ///< triangulation: largest position standard deviation [m]
+  /// What a track seen from a leaving state contributes: whole_track (all its
+  /// observations; the track restarts) or leaving_views (paper Algorithm 4:
+  /// only its views from the leaving states, when it was seen from all of
+  /// them; the track goes on without them).
+  std::string msckf_leaving_update = "leaving_views";
 
   template <class V>
   void Visit(V& v) {
     v("msckf_gn_steps", msckf_gn_steps, "MSCKF: Gauss-Newton steps per update (fixed_lag: to convergence) [count]");
+    v("msckf_leaving_update", msckf_leaving_update,
+      "MSCKF: a track seen from a leaving state is used whole and restarts (whole_track), or gives only its views "
+      "from the leaving states when seen from all of them and goes on (leaving_views, paper Algorithm 4)",
+      {"whole_track", "leaving_views"});
     v("msckf_min_track_length", msckf_min_track_length, "MSCKF: observations a track needs to be used [frames]");
     v("msckf_max_reprojection", msckf_max_reprojection,
       "MSCKF triangulation: largest whitened reprojection error [sigma]");

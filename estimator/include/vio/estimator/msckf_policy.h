@@ -4,17 +4,20 @@
 //
 // States are linked by IMU factors as in every policy. Landmarks are NOT
 // parameters while their tracks grow: the policy keeps their observations.
-// A track is used when it ends (not seen in the newest frame) or when a
-// state it was seen from is about to leave: the landmark is triangulated from
-// all its observations in the window (multi-view, refined by Gauss-Newton,
-// rejected when ill-conditioned, behind a camera or inconsistent), added with
-// all its observations, the window takes `msckf_gn_steps` Gauss-Newton steps
-// (one: the MSCKF update; to convergence: fixed_lag), and the landmark is
-// marginalized at once. When the window exceeds n states, the evenly spaced
-// states x_i, i mod 3 == 2 (1-based, oldest first), are marginalized in the
-// same step, after their observations were used: older poses thin out, so
-// the window reaches arbitrarily far into the past.
+// A track is used when it ends (not seen in the newest frame): the landmark
+// is triangulated from all its observations in the window (multi-view,
+// refined by Gauss-Newton, rejected when ill-conditioned, behind a camera or
+// inconsistent), added with them, the window takes `msckf_gn_steps`
+// Gauss-Newton steps (one: the MSCKF update; to convergence: fixed_lag), and
+// the landmark is marginalized at once. When the window exceeds n states, the
+// evenly spaced states x_i, i mod 3 == 2 (1-based, oldest first), are
+// marginalized in the same step, after their observations were used: a track
+// seen from every leaving state gives those views (Algorithm 4, line 12) and
+// goes on without them (`leaving_views`), or, with `whole_track`, any track
+// seen from a leaving state is used whole and restarts. Older poses thin
+// out, so the window reaches arbitrarily far into the past.
 #include <map>
+#include <optional>
 #include <vector>
 
 #include "vio/estimator/policy.h"
@@ -37,10 +40,17 @@ class MsckfPolicy final : public Policy {
 
  private:
   using Observation = std::pair<StateId, Eigen::Vector3d>;
+  /// Observations of one landmark to triangulate, add and marginalize now.
+  struct TrackUpdate {
+    LandmarkId id;
+    std::vector<Observation> observations;
+  };
 
   std::vector<StateId> LeavingStates(const Window& window) const;
-  std::vector<LandmarkId> MatureTracks(const StereoFrame& frame, const std::vector<StateId>& leaving);
-  std::vector<LandmarkId> AddTriangulated(const std::vector<LandmarkId>& mature, Window& window);
+  std::vector<TrackUpdate> MatureTracks(const StereoFrame& frame, const std::vector<StateId>& leaving);
+  std::optional<TrackUpdate> LeavingViews(std::vector<Observation>& track, LandmarkId id,
+                                          const std::vector<StateId>& leaving) const;
+  std::vector<LandmarkId> AddTriangulated(const std::vector<TrackUpdate>& updates, Window& window);
   void ForgetObservationsOf(const std::vector<StateId>& leaving);
 
   EstimatorOptions options_;
