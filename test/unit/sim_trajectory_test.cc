@@ -92,5 +92,24 @@ TEST(InterpolatePoseTest, SlerpAndLinearBetweenSamplesNulloptOutside) {
   EXPECT_FALSE(InterpolatePose(gt, 2001).has_value());
 }
 
+// 1 m/s along x at 200 Hz with one 10 cm glitch: exactly that step is found.
+TEST(GroundTruthJumpsTest, FindsAStepThatDisagreesWithTheVelocity) {
+  std::vector<GroundTruthState> gt(400);
+  for (size_t i = 0; i < gt.size(); ++i) {
+    gt[i].t_ns = static_cast<Timestamp>(i) * 5'000'000;
+    gt[i].p_w_b = Eigen::Vector3d(0.005 * static_cast<double>(i) + (i >= 200 ? 0.1 : 0.0), 0, 0);
+    gt[i].v_w_b = Eigen::Vector3d(1, 0, 0);
+  }
+  const std::vector<GroundTruthJump> jumps = FindGroundTruthJumps(gt, 5.0);
+  ASSERT_EQ(jumps.size(), 1u);
+  EXPECT_EQ(jumps[0].t_ns, 199 * 5'000'000);
+  EXPECT_NEAR(jumps[0].step_m, 0.105, 1e-12);
+  EXPECT_NEAR(jumps[0].speed_m_s, 21.0, 1e-9);
+  EXPECT_NEAR(jumps[0].velocity_m_s, 1.0, 1e-12);
+  // Without velocities (TUM text) nothing can be judged.
+  for (GroundTruthState& s : gt) s.has_velocity_and_biases = false;
+  EXPECT_TRUE(FindGroundTruthJumps(gt, 5.0).empty());
+}
+
 }  // namespace
 }  // namespace vio::tools

@@ -180,4 +180,20 @@ std::optional<Eigen::Isometry3d> InterpolatePose(const std::vector<GroundTruthSt
   return T_w_b;
 }
 
+std::vector<GroundTruthJump> FindGroundTruthJumps(const std::vector<GroundTruthState>& groundtruth,
+                                                  double tolerance_m_s) {
+  std::vector<GroundTruthJump> jumps;
+  for (size_t i = 1; i < groundtruth.size(); ++i) {
+    const GroundTruthState& a = groundtruth[i - 1];
+    const GroundTruthState& b = groundtruth[i];
+    if (!a.has_velocity_and_biases || b.t_ns <= a.t_ns) continue;
+    const double dt_s = NanosToSeconds(b.t_ns - a.t_ns);
+    const Eigen::Vector3d step = b.p_w_b - a.p_w_b;
+    const Eigen::Vector3d mean_velocity = 0.5 * (a.v_w_b + b.v_w_b);
+    if ((step / dt_s - mean_velocity).norm() <= tolerance_m_s) continue;
+    jumps.push_back({a.t_ns, step.norm(), step.norm() / dt_s, mean_velocity.norm()});
+  }
+  return jumps;
+}
+
 }  // namespace vio::tools

@@ -85,4 +85,20 @@ Eigen::Matrix3d HeadingFromBody();
 std::optional<Eigen::Isometry3d> InterpolatePose(const std::vector<GroundTruthState>& groundtruth,
                                                  Timestamp t_ns);
 
+/// A ground-truth step whose displacement disagrees with the ground truth's
+/// own velocity: a glitch of the reference (EuRoC MH_04_difficult has one of
+/// 14 cm in 5 ms). A hybrid simulation follows it with its cameras while the
+/// real IMU does not.
+struct GroundTruthJump {
+  Timestamp t_ns = 0;        ///< start of the step
+  double step_m = 0.0;       ///< |p(t_b) - p(t_a)| [m]
+  double speed_m_s = 0.0;    ///< step_m / (t_b - t_a) [m/s]
+  double velocity_m_s = 0.0; ///< |v(t_a) + v(t_b)| / 2 from the ground truth [m/s]
+};
+
+/// The steps where |(p_b - p_a) / (t_b - t_a) - (v_a + v_b) / 2| exceeds
+/// tolerance_m_s; none for a ground truth without velocities (TUM).
+std::vector<GroundTruthJump> FindGroundTruthJumps(const std::vector<GroundTruthState>& groundtruth,
+                                                  double tolerance_m_s);
+
 }  // namespace vio::tools
