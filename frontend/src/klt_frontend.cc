@@ -1,6 +1,8 @@
 #include "vio/frontend/klt_frontend.h"
 
 #include <algorithm>
+#include <cmath>
+#include <stdexcept>
 #include <unordered_set>
 
 #include <opencv2/features2d.hpp>
@@ -15,37 +17,59 @@ bool Inside(const cv::Point2f& p, const cv::Mat& image) {
          p.y <= static_cast<float>(image.rows - 1);
 }
 
-/// Depth whose disparity seeds new features before any feature has one [m].
-constexpr double kDefaultDepthM = 5.0;
-
+/// A row-search disparity this close to the one LK already failed from is
+/// not tried again [px].
+constexpr double kSameSeedPx = 1.0;
+/// Side of the row search's patch [px].
+constexpr int kRowSearchPatchPx = 11;
+/// Corners tried by the row search per grid cell and frame, per feature the
+/// cell still wants [count].
+constexpr int kSearchesPerWantedFeature = 2;
+/// Pyramid levels of the left -> right LK: its seeds (the last or the
+/// row-search disparity) are within a few pixels, and coarser levels, which
+/// see a wide neighbourhood, are misled where the two views differ most
+/// (the slanted near floor, occluding edges) [count].
+constexpr int kStereoPyramidLevels = 0;
+/// New corners are sought only when at least this fraction of
+/// klt_max_features is missing: FAST and the sort of its corners cost about
+/// 2 ms on a 752x480 frame, and a handful of lost features is refilled a few
+/// frames later (0.05 on the rendered V2_01: 296 -> 290 stereo features per
+/// frame, detection 2.1 -> 0.8 ms per frame).
+constexpr double kMinMissingFraction = 0.05;
+/// Pyramid levels of the temporal LK from an IMU-predicted pixel, which is
+/// within a few pixels unless the prediction is bad (then the track is
+/// retried from its previous pixel over klt_pyramid_levels) [count].
+constexpr int kPredictedPyramidLevels = 1;
 /// Features unmatched left-right for more consecutive frames are dropped.
 constexpr int kMaxFramesWithoutStereo = 3;
 
-double Median(std::vector<double> values, double fallback) {
-  if (values.empty()) return fallback;
-  const auto mid = values.begin() + static_cast<long>(values.size() / 2);
-  std::nth_element(values.begin(), mid, values.end());
-  return *mid;
+FrontendOptions Checked(const FrontendOptions& options) {
+  if (options.klt_max_features <= 0) throw std::invalid_argument("front end options: klt_max_features must be > 0");
+  return options;
 }
 
 }  // namespace
 
 KltFrontend::KltFrontend(const FrontendOptions& options, const StereoRectifier& rectifier)
-    : StereoFrontend(options, rectifier),
-      grid_(rectifier.camera_model(0).width(), rectifier.camera_model(0).height(), options.grid_cell_px) {}
+    : StereoFrontend(Checked(options), rectifier),
+      grid_(rectifier.camera_model(0).width(), rectifier.camera_model(0).height(), options.grid_cell_px),
+      row_search_(rectifier, kRowSearchPatchPx, options.klt_max_disparity_px, options.klt_min_ncc) {}
 
 std::vector<FrameFeature> KltFrontend::TrackFrame(const cv::Mat& left, const cv::Mat& right,
                                                   const FramePrior& prior) {
   std::int64_t start = NowNs();
-  const std::vector<cv::Mat> left_pyramid = Pyramid(left);
-  TrackTemporal(left_pyramid);
+  const std::vector<cv::Mat> left_pyramid = Pyramid(left, options().klt_pyramid_levels);
+  TrackTemporal(left_pyramid, prior);
   AddTime(&StageTimes::temporal_ms, start);
   start = NowNs();
-  DetectNew(left);
-  AddTime(&StageTimes::detect_ms, start);
-  start = NowNs();
-  std::vector<FrameFeature> features = MatchStereo(left_pyramid, Pyramid(right));
+  const std::vector<cv::Mat> right_pyramid = Pyramid(right, kStereoPyramidLevels);
+  const StereoImages images{left, right, left_pyramid, right_pyramid};
+  MatchTracks(images);
   AddTime(&StageTimes::stereo_ms, start);
+  start = NowNs();
+  DetectNew(images);
+  AddTime(&StageTimes::detect_ms, start);
+  std::vector<FrameFeature> features = Features();
   const std::vector<LandmarkId> rejected = RejectOutliers(prior, &features);
   std::unordered_set<std::int64_t> dropped;
   for (LandmarkId id : rejected) dropped.insert(id.value);
@@ -56,20 +80,19 @@ std::vector<FrameFeature> KltFrontend::TrackFrame(const cv::Mat& left, const cv:
   return features;
 }
 
-std::vector<cv::Mat> KltFrontend::Pyramid(const cv::Mat& image) const {
+std::vector<cv::Mat> KltFrontend::Pyramid(const cv::Mat& image, int levels) const {
   std::vector<cv::Mat> pyramid;
   const int side = options().klt_window_px;
-  cv::buildOpticalFlowPyramid(image, pyramid, cv::Size(side, side), options().klt_pyramid_levels);
+  cv::buildOpticalFlowPyramid(image, pyramid, cv::Size(side, side), levels);
   return pyramid;
 }
 
 std::vector<bool> KltFrontend::TrackPoints(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
                                            const std::vector<cv::Point2f>& points,
-                                           std::vector<cv::Point2f>* guess) const {
+                                           std::vector<cv::Point2f>* guess, int levels) const {
   std::vector<bool> kept(points.size(), false);
   if (points.empty()) return kept;
   const cv::Size window(options().klt_window_px, options().klt_window_px);
-  const int levels = options().klt_pyramid_levels;
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
   std::vector<uchar> status, back_status;
   std::vector<float> error;
@@ -85,13 +108,28 @@ std::vector<bool> KltFrontend::TrackPoints(const std::vector<cv::Mat>& from, con
   return kept;
 }
 
-void KltFrontend::TrackTemporal(const std::vector<cv::Mat>& left) {
+// Tracks with a predicted pixel first, from there over kPredictedPyramidLevels;
+// the others, and those that fail, from their previous pixel over the whole
+// pyramid.
+void KltFrontend::TrackTemporal(const std::vector<cv::Mat>& left, const FramePrior& prior) {
   for (Track& t : tracks_) t.tracked = false;
   if (previous_left_.empty() || tracks_.empty()) return;
-  std::vector<cv::Point2f> points, moved;
-  for (const Track& t : tracks_) points.push_back(t.uv0_px);
-  moved = points;
-  const std::vector<bool> kept = TrackPoints(previous_left_, left, points, &moved);
+  std::vector<size_t> predicted, rest;
+  std::vector<cv::Point2f> guesses;
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    const std::optional<cv::Point2f> guess = PredictedPixel(tracks_[i].id, prior);
+    (guess ? predicted : rest).push_back(i);
+    if (guess) guesses.push_back(*guess);
+  }
+  std::vector<bool> kept(tracks_.size(), false);
+  std::vector<cv::Point2f> moved(tracks_.size());
+  TrackSome(left, predicted, guesses, kPredictedPyramidLevels, &kept, &moved);
+  for (size_t i : predicted) {
+    if (!kept[i]) rest.push_back(i);
+  }
+  guesses.clear();
+  for (size_t i : rest) guesses.push_back(tracks_[i].uv0_px);
+  TrackSome(left, rest, guesses, options().klt_pyramid_levels, &kept, &moved);
   std::vector<Track> survivors;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (!kept[i]) continue;
@@ -104,7 +142,90 @@ void KltFrontend::TrackTemporal(const std::vector<cv::Mat>& left) {
   tracks_ = std::move(survivors);
 }
 
+void KltFrontend::TrackSome(const std::vector<cv::Mat>& left, const std::vector<size_t>& which,
+                            std::vector<cv::Point2f> guesses, int levels, std::vector<bool>* kept,
+                            std::vector<cv::Point2f>* moved) const {
+  std::vector<cv::Point2f> points;
+  for (size_t i : which) points.push_back(tracks_[i].uv0_px);
+  const std::vector<bool> ok = TrackPoints(previous_left_, left, points, &guesses, levels);
+  for (size_t j = 0; j < which.size(); ++j) {
+    (*kept)[which[j]] = ok[j];
+    (*moved)[which[j]] = guesses[j];
+  }
+}
+
+// The landmark (the window's estimate, else the track's own triangulation)
+// projected into the IMU-predicted rectified left camera, then into the raw
+// left image.
+std::optional<cv::Point2f> KltFrontend::PredictedPixel(LandmarkId id, const FramePrior& prior) const {
+  if (!prior.T_w_b) return std::nullopt;
+  const std::optional<Eigen::Vector3d> p_w = LandmarkPosition(id, prior);
+  if (!p_w) return std::nullopt;
+  const RectifiedStereo& stereo = rectifier().rectified();
+  const Eigen::Vector3d p_cl = (*prior.T_w_b * stereo.T_b_cl).inverse() * *p_w;
+  if (p_cl.z() <= 0.0) return std::nullopt;
+  const std::optional<Eigen::Vector2d> uv =
+      rectifier().camera_model(0).Project(rectifier().R_rect_cam(0).transpose() * p_cl);
+  if (!uv) return std::nullopt;
+  return cv::Point2f(static_cast<float>(uv->x()), static_cast<float>(uv->y()));
+}
+
+// LK from the last disparity; the tracks it fails for, from the row search's
+// disparity when that is a different seed.
+void KltFrontend::MatchTracks(const StereoImages& images) {
+  std::vector<Track*> all;
+  for (Track& t : tracks_) {
+    t.match.reset();
+    all.push_back(&t);
+  }
+  MatchAt(images, all);
+  std::vector<Track*> retry;
+  for (Track& t : tracks_) {
+    if (t.match) continue;
+    const std::optional<double> d = SearchRow(images, t.uv0_px);
+    if (!d || std::abs(*d - t.disparity_px) < kSameSeedPx) continue;
+    t.disparity_px = *d;
+    retry.push_back(&t);
+  }
+  MatchAt(images, retry);
+}
+
+std::optional<double> KltFrontend::SearchRow(const StereoImages& images, const cv::Point2f& uv0_px) const {
+  const std::optional<Eigen::Vector2d> rect = rectifier().Rectify(0, Eigen::Vector2d(uv0_px.x, uv0_px.y));
+  if (!rect) return std::nullopt;
+  return row_search_.Disparity(images.left, images.right, *rect);
+}
+
+// LK from the right pixel at each track's disparity, forward-backward
+// checked, then the epipolar check.
+void KltFrontend::MatchAt(const StereoImages& images, const std::vector<Track*>& tracks) {
+  std::vector<cv::Point2f> points, matched;
+  for (const Track* t : tracks) {
+    points.push_back(t->uv0_px);
+    matched.push_back(RightPixelAt(t->uv0_px, t->disparity_px));
+  }
+  const std::vector<bool> kept = TrackPoints(images.left_pyramid, images.right_pyramid, points, &matched,
+                                             kStereoPyramidLevels);
+  for (size_t j = 0; j < tracks.size(); ++j) {
+    if (!kept[j]) continue;
+    const Eigen::Vector2d uv1(matched[j].x, matched[j].y);
+    const std::optional<Eigen::Vector3d> z = StereoMeasurement(Eigen::Vector2d(points[j].x, points[j].y), uv1);
+    if (z) tracks[j]->match = StereoMatch{uv1, *z};
+  }
+}
+
+cv::Point2f KltFrontend::RightPixelAt(const cv::Point2f& uv0_px, double disparity_px) const {
+  const std::optional<Eigen::Vector2d> left = rectifier().Rectify(0, Eigen::Vector2d(uv0_px.x, uv0_px.y));
+  if (!left) return uv0_px;
+  const RectifiedStereo& r = rectifier().rectified();
+  const Eigen::Vector3d ray_rect((left->x() - disparity_px - r.cx) / r.f, (left->y() - r.cy) / r.f, 1.0);
+  const std::optional<Eigen::Vector2d> uv1 =
+      rectifier().camera_model(1).ProjectUnbounded(rectifier().R_rect_cam(1).transpose() * ray_rect);
+  return uv1 ? cv::Point2f(static_cast<float>(uv1->x()), static_cast<float>(uv1->y())) : uv0_px;
+}
+
 cv::Mat KltFrontend::Thin(const cv::Mat& left, std::vector<int>* per_cell) {
+  for (Track& t : tracks_) t.frames_without_stereo = t.match ? 0 : t.frames_without_stereo + 1;
   std::stable_sort(tracks_.begin(), tracks_.end(), [](const Track& a, const Track& b) { return a.age > b.age; });
   per_cell->assign(static_cast<size_t>(grid_.num_cells()), 0);
   cv::Mat mask(left.size(), CV_8UC1, cv::Scalar(255));
@@ -125,75 +246,82 @@ cv::Mat KltFrontend::Thin(const cv::Mat& left, std::vector<int>* per_cell) {
   return mask;
 }
 
-// New FAST corners, strongest first, at least klt_min_distance_px from every
-// feature, into the cells holding fewer than klt_per_cell.
-void KltFrontend::DetectNew(const cv::Mat& left) {
-  std::vector<int> count;
-  cv::Mat mask = Thin(left, &count);
-  const int per_cell = options().klt_per_cell;
-  if (std::none_of(count.begin(), count.end(), [&](int n) { return n < per_cell; })) return;
-  std::vector<cv::KeyPoint> corners;
-  cv::FAST(left, corners, options().klt_fast_threshold, /*nonmaxSuppression=*/true);
-  std::stable_sort(corners.begin(), corners.end(),
-                   [](const cv::KeyPoint& a, const cv::KeyPoint& b) { return a.response > b.response; });
-  const int radius = static_cast<int>(options().klt_min_distance_px);
-  for (const cv::KeyPoint& c : corners) {
-    int& n = count[static_cast<size_t>(grid_.Cell(c.pt))];
-    const cv::Point pixel(cvRound(c.pt.x), cvRound(c.pt.y));
-    if (n >= per_cell || mask.at<uchar>(pixel) == 0) continue;
-    ++n;
-    cv::circle(mask, pixel, radius, cv::Scalar(0), cv::FILLED);
-    Track t;
+// Candidates are stereo-matched at once; only the matched ones become
+// features (and get an id).
+void KltFrontend::DetectNew(const StereoImages& images) {
+  std::vector<int> per_cell;
+  cv::Mat mask = Thin(images.left, &per_cell);
+  std::vector<Track> candidates = Candidates(images, &mask, &per_cell);
+  std::vector<Track*> pointers;
+  for (Track& t : candidates) pointers.push_back(&t);
+  MatchAt(images, pointers);
+  for (Track& t : candidates) {
+    if (!t.match) continue;
     t.id = NewTrack();
-    t.uv0_px = c.pt;
     tracks_.push_back(t);
   }
 }
 
-cv::Point2f KltFrontend::RightPixelAt(const cv::Point2f& uv0_px, double disparity_px) const {
-  const std::optional<Eigen::Vector2d> left = rectifier().Rectify(0, Eigen::Vector2d(uv0_px.x, uv0_px.y));
-  if (!left) return uv0_px;
-  const RectifiedStereo& r = rectifier().rectified();
-  const Eigen::Vector3d ray_rect((left->x() - disparity_px - r.cx) / r.f, (left->y() - r.cy) / r.f, 1.0);
-  const std::optional<Eigen::Vector2d> uv1 =
-      rectifier().camera_model(1).ProjectUnbounded(rectifier().R_rect_cam(1).transpose() * ray_rect);
-  return uv1 ? cv::Point2f(static_cast<float>(uv1->x()), static_cast<float>(uv1->y())) : uv0_px;
+// FAST corners strongest first, in rounds: round r gives each cell holding
+// fewer than r features one more, up to klt_per_cell per cell and
+// klt_max_features in all (none while fewer than kMinMissingFraction of them
+// are missing); a corner must be klt_min_distance_px from every
+// feature and found by the row search (at most kSearchesPerWantedFeature
+// tries per wanted feature and cell).
+std::vector<KltFrontend::Track> KltFrontend::Candidates(const StereoImages& images, cv::Mat* mask,
+                                                        std::vector<int>* per_cell) const {
+  const int per_cell_max = options().klt_per_cell;
+  const int wanted = options().klt_max_features - static_cast<int>(tracks_.size());
+  std::vector<Track> candidates;
+  const bool open = std::any_of(per_cell->begin(), per_cell->end(), [&](int n) { return n < per_cell_max; });
+  if (!open || wanted < kMinMissingFraction * options().klt_max_features) {
+    return candidates;
+  }
+  std::vector<cv::KeyPoint> corners;
+  cv::FAST(images.left, corners, options().klt_fast_threshold, /*nonmaxSuppression=*/true);
+  std::stable_sort(corners.begin(), corners.end(),
+                   [](const cv::KeyPoint& a, const cv::KeyPoint& b) { return a.response > b.response; });
+  std::vector<int> searches(per_cell->size(), 0);
+  std::vector<int> search_budget(per_cell->size());
+  for (size_t c = 0; c < per_cell->size(); ++c) {
+    search_budget[c] = kSearchesPerWantedFeature * std::max(0, per_cell_max - (*per_cell)[c]);
+  }
+  const int radius = static_cast<int>(options().klt_min_distance_px);
+  for (int round = 1; round <= per_cell_max; ++round) {
+    for (const cv::KeyPoint& corner : corners) {
+      if (static_cast<int>(candidates.size()) >= wanted) return candidates;
+      const auto cell = static_cast<size_t>(grid_.Cell(corner.pt));
+      const cv::Point pixel(cvRound(corner.pt.x), cvRound(corner.pt.y));
+      if ((*per_cell)[cell] >= round || searches[cell] >= search_budget[cell] || mask->at<uchar>(pixel) == 0) {
+        continue;
+      }
+      ++searches[cell];
+      const std::optional<double> disparity = SearchRow(images, corner.pt);
+      if (!disparity) continue;
+      ++(*per_cell)[cell];
+      cv::circle(*mask, pixel, radius, cv::Scalar(0), cv::FILLED);
+      Track t;
+      t.uv0_px = corner.pt;
+      t.disparity_px = *disparity;
+      candidates.push_back(t);
+    }
+  }
+  return candidates;
 }
 
-// Left -> right LK from the previous disparity (else the median one), then
-// the epipolar check.
-std::vector<FrameFeature> KltFrontend::MatchStereo(const std::vector<cv::Mat>& left,
-                                                   const std::vector<cv::Mat>& right) {
-  std::vector<double> known;
-  for (const Track& t : tracks_) {
-    if (t.has_disparity) known.push_back(t.disparity_px);
-  }
-  const RectifiedStereo& stereo = rectifier().rectified();
-  const double fallback = Median(known, stereo.f * stereo.baseline / kDefaultDepthM);
-  std::vector<cv::Point2f> points, matched;
-  for (const Track& t : tracks_) {
-    points.push_back(t.uv0_px);
-    matched.push_back(RightPixelAt(t.uv0_px, t.has_disparity ? t.disparity_px : fallback));
-  }
-  const std::vector<bool> kept = TrackPoints(left, right, points, &matched);
+// One feature per track; the stereo ones carry their match.
+std::vector<FrameFeature> KltFrontend::Features() {
   std::vector<FrameFeature> features;
-  for (size_t i = 0; i < tracks_.size(); ++i) {
-    Track& t = tracks_[i];
+  for (Track& t : tracks_) {
     FrameFeature f;
     f.id = t.id;
     f.tracked = t.tracked;
     f.uv0_px = Eigen::Vector2d(t.uv0_px.x, t.uv0_px.y);
-    const std::optional<Eigen::Vector3d> z =
-        kept[i] ? StereoMeasurement(f.uv0_px, Eigen::Vector2d(matched[i].x, matched[i].y)) : std::nullopt;
-    if (z) {
-      f.uv1_px = Eigen::Vector2d(matched[i].x, matched[i].y);
-      f.z_px = *z;
+    if (t.match) {
+      f.uv1_px = t.match->uv1_px;
+      f.z_px = t.match->z_px;
       f.stereo = true;
-      t.disparity_px = z->x() - z->y();
-      t.has_disparity = true;
-      t.frames_without_stereo = 0;
-    } else {
-      ++t.frames_without_stereo;
+      t.disparity_px = f.z_px.x() - f.z_px.y();
     }
     features.push_back(f);
   }

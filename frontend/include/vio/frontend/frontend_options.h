@@ -25,18 +25,24 @@ struct FrontendOptions {
   int max_hamming_bits = 90;
   /// BRISK: tracks seen in the last this many frames are matched to the new one [frames].
   int track_window_frames = 3;
-  /// KLT: features wanted per grid cell; new corners fill cells below it [count].
-  int klt_per_cell = 2;
+  /// KLT: most features per grid cell; new corners fill cells below it [count].
+  int klt_per_cell = 4;
+  /// KLT: most features in the image [count].
+  int klt_max_features = 300;
   /// KLT: FAST corner threshold [grey levels].
   int klt_fast_threshold = 20;
   /// KLT: minimum distance between features [px].
-  double klt_min_distance_px = 15.0;
+  double klt_min_distance_px = 10.0;
   /// KLT: Lucas-Kanade window side [px].
   int klt_window_px = 15;
   /// KLT: pyramid levels above the full image.
   int klt_pyramid_levels = 3;
   /// KLT: largest forward-backward tracking error [px].
   double klt_max_fb_px = 1.0;
+  /// KLT: largest disparity the stereo row search tries [px].
+  double klt_max_disparity_px = 128.0;
+  /// KLT: smallest ZNCC score of a stereo row-search match [-1, 1].
+  double klt_min_ncc = 0.8;
   /// Folder receiving one PNG per frame with the tracks drawn; empty = none.
   std::string debug_images;
 
@@ -56,12 +62,15 @@ struct FrontendOptions {
     v("max_hamming_bits", max_hamming_bits, "largest Hamming distance of a BRISK match [bits of 512]");
     v("track_window_frames", track_window_frames,
       "BRISK matches the new frame to tracks seen in this many previous frames [frames]");
-    v("klt_per_cell", klt_per_cell, "KLT features wanted per grid cell [count]");
+    v("klt_per_cell", klt_per_cell, "KLT most features per grid cell [count]");
+    v("klt_max_features", klt_max_features, "KLT most features in the image [count]");
     v("klt_fast_threshold", klt_fast_threshold, "KLT FAST corner threshold [grey levels]");
     v("klt_min_distance_px", klt_min_distance_px, "KLT minimum distance between features [px]");
     v("klt_window_px", klt_window_px, "KLT Lucas-Kanade window side [px]");
     v("klt_pyramid_levels", klt_pyramid_levels, "KLT pyramid levels above the full image [count]");
     v("klt_max_fb_px", klt_max_fb_px, "KLT largest forward-backward tracking error [px]");
+    v("klt_max_disparity_px", klt_max_disparity_px, "KLT largest disparity the stereo row search tries [px]");
+    v("klt_min_ncc", klt_min_ncc, "KLT smallest ZNCC score of a stereo row-search match [-1, 1]");
     v("debug_images", debug_images, "folder for one PNG per frame with the tracks drawn; empty = none");
   }
 };

@@ -112,12 +112,14 @@ class StereoFrontend {
   std::vector<LandmarkId> RejectOutliers(const FramePrior& prior, std::vector<FrameFeature>* features);
 
   LandmarkId NewTrack();
+  /// The landmark's position: the window's estimate, else the track's own
+  /// stereo triangulation; nullopt when neither exists.
+  std::optional<Eigen::Vector3d> LandmarkPosition(LandmarkId id, const FramePrior& prior) const;
   /// Adds the elapsed time since `start` to a stage of the current frame.
   void AddTime(double StageTimes::*stage, std::int64_t start_ns);
   static std::int64_t NowNs();
 
  private:
-  std::optional<Eigen::Vector3d> LandmarkPosition(LandmarkId id, const FramePrior& prior) const;
   StereoFrame Emit(Timestamp t_ns, const FramePrior& prior);
 
   FrontendOptions options_;
