@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <future>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -51,7 +52,7 @@ class ImageFrameSource final : public FrameSource {
   StereoFrame Frame(size_t k, const Estimator& estimator) override {
     const Pair& pair = pairs_[k];
     const auto start = std::chrono::steady_clock::now();
-    const cv::Mat left = Load(0, pair.left), right = Load(1, pair.right);
+    const auto [left, right] = TakeImages(k);
     load_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     frontend::FramePrior prior;
     prior.T_w_b = estimator.PredictBodyPose(pair.t_ns);
@@ -83,6 +84,21 @@ class ImageFrameSource final : public FrameSource {
     if (unpaired_ > 0) LOG(WARNING) << mav0_ << ": " << unpaired_ << " cam0 frames have no cam1 image; skipped";
   }
 
+  // Pair k, decoded by the read-ahead started for it (else now); starts the
+  // read-ahead of pair k + 1 on another thread, so decoding overlaps tracking.
+  std::pair<cv::Mat, cv::Mat> TakeImages(size_t k) {
+    std::pair<cv::Mat, cv::Mat> images = next_.valid() && next_k_ == k ? next_.get() : LoadPair(k);
+    if (k + 1 < pairs_.size()) {
+      next_k_ = k + 1;
+      next_ = std::async(std::launch::async, [this, k] { return LoadPair(k + 1); });
+    }
+    return images;
+  }
+
+  std::pair<cv::Mat, cv::Mat> LoadPair(size_t k) const {
+    return {Load(0, pairs_[k].left), Load(1, pairs_[k].right)};
+  }
+
   cv::Mat Load(int camera, const std::string& filename) const {
     const std::string path = mav0_ + "/cam" + std::to_string(camera) + "/data/" + filename;
     cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
@@ -105,6 +121,8 @@ class ImageFrameSource final : public FrameSource {
   std::vector<Pair> pairs_;
   int unpaired_ = 0;
   double load_ms_ = 0;
+  std::future<std::pair<cv::Mat, cv::Mat>> next_;  ///< read-ahead (declared last: joined first)
+  size_t next_k_ = 0;
 };
 
 std::string TrackLengthJson(const frontend::FeatureTracks& tracks) {
