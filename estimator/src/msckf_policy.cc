@@ -18,6 +18,10 @@ Eigen::Isometry3d BodyPose(const State& s) {
   return T_w_b;
 }
 
+bool IsLeaving(StateId state, const std::vector<StateId>& leaving) {
+  return std::find(leaving.begin(), leaving.end(), state) != leaving.end();
+}
+
 }  // namespace
 
 MsckfPolicy::MsckfPolicy(const EstimatorOptions& options, int gn_steps) : options_(options), gn_steps_(gn_steps) {
@@ -78,20 +82,19 @@ std::vector<MsckfPolicy::TrackUpdate> MsckfPolicy::MatureTracks(const StereoFram
     std::vector<Observation>& observations = it->second;
     const bool ended = seen_now.count(it->first) == 0;
     const bool long_enough = static_cast<int>(observations.size()) >= options_.msckf.msckf_min_track_length;
-    const bool loses_state = std::any_of(observations.begin(), observations.end(), [&](const Observation& o) {
-      return std::find(leaving.begin(), leaving.end(), o.first) != leaving.end();
-    });
-    if (ended || (whole_track && loses_state)) {
-      if (long_enough) {
-        updates.push_back({it->first, std::move(observations)});
-      } else if (ended) {
-        ++counts_.too_short;
-      }
-      if (long_enough || ended) {
-        it = tracks_.erase(it);
-        continue;
-      }
-    } else if (loses_state) {
+    const bool loses_state = std::any_of(observations.begin(), observations.end(),
+                                         [&](const Observation& o) { return IsLeaving(o.first, leaving); });
+    if (ended && !long_enough) {
+      ++counts_.too_short;
+      it = tracks_.erase(it);
+      continue;
+    }
+    if (long_enough && (ended || (whole_track && loses_state))) {
+      updates.push_back({it->first, std::move(observations)});
+      it = tracks_.erase(it);
+      continue;
+    }
+    if (loses_state && !whole_track) {
       if (std::optional<TrackUpdate> update = LeavingViews(observations, it->first, leaving)) {
         updates.push_back(std::move(*update));
       }
@@ -107,16 +110,14 @@ std::optional<MsckfPolicy::TrackUpdate> MsckfPolicy::LeavingViews(std::vector<Ob
                                                                   const std::vector<StateId>& leaving) const {
   TrackUpdate update{id, {}};
   for (const Observation& o : track) {
-    if (std::find(leaving.begin(), leaving.end(), o.first) != leaving.end()) update.observations.push_back(o);
+    if (IsLeaving(o.first, leaving)) update.observations.push_back(o);
   }
   if (update.observations.size() != leaving.size() ||
       static_cast<int>(update.observations.size()) < options_.msckf.msckf_min_track_length) {
     return std::nullopt;
   }
   track.erase(std::remove_if(track.begin(), track.end(),
-                             [&](const Observation& o) {
-                               return std::find(leaving.begin(), leaving.end(), o.first) != leaving.end();
-                             }),
+                             [&](const Observation& o) { return IsLeaving(o.first, leaving); }),
               track.end());
   return update;
 }
@@ -151,9 +152,7 @@ void MsckfPolicy::ForgetObservationsOf(const std::vector<StateId>& leaving) {
   for (auto it = tracks_.begin(); it != tracks_.end();) {
     auto& observations = it->second;
     observations.erase(std::remove_if(observations.begin(), observations.end(),
-                                      [&](const Observation& o) {
-                                        return std::find(leaving.begin(), leaving.end(), o.first) != leaving.end();
-                                      }),
+                                      [&](const Observation& o) { return IsLeaving(o.first, leaving); }),
                        observations.end());
     it = observations.empty() ? tracks_.erase(it) : std::next(it);
   }

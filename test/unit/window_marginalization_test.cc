@@ -5,66 +5,26 @@
 // zero there), and the problem must keep solving afterwards.
 #include <gtest/gtest.h>
 
-#include "vio/estimator/imu_preintegration.h"
+#include "synthetic_window.h"
 #include "vio/estimator/policy.h"
 #include "vio/estimator/window.h"
-#include "vio/frontend/stereo_rectifier.h"
-#include "vio/tools/simulator.h"
-#include "vio/tools/stereo_frames.h"
 
 namespace vio {
 namespace {
 
 constexpr int kFrames = 8;
 
+// The window of kFrames states the tests marginalize from (no robust loss: a
+// pure least-squares cost).
 struct WindowFixture {
-  tools::Simulation sim;
-  std::vector<StereoFrame> frames;
-  RectifiedStereo stereo;
-  ModelOptions model;
+  test::SyntheticFlight flight{6.0, 7};
+  ModelOptions model = [] {
+    ModelOptions m;
+    m.huber_px = 0;
+    return m;
+  }();
 
-  WindowFixture() {
-    tools::SimulatorOptions options;
-    options.duration_s = 6.0;
-    options.seed = 7;
-    sim = tools::BuildSimulation(options);
-    const frontend::StereoRectifier rectifier(sim.dataset.cameras[0], sim.dataset.cameras[1]);
-    stereo = rectifier.rectified();
-    tools::StereoFramesReport report;
-    frames = tools::StereoFramesFromFeatures(sim.dataset.features, sim.dataset.frames[0], rectifier, 2.0, &report);
-    model.huber_px = 0;  // a pure least-squares cost
-  }
-
-  const tools::GroundTruthState& NearestGroundTruth(Timestamp t_ns) const {
-    const auto& gt = sim.dataset.groundtruth;
-    auto it = std::lower_bound(gt.begin(), gt.end(), t_ns,
-                               [](const tools::GroundTruthState& g, Timestamp t) { return g.t_ns < t; });
-    return it == gt.end() ? gt.back() : *it;
-  }
-
-  // States at frames [first, first + kFrames) of the moving part, at ground
-  // truth, linked by IMU factors; every observation added.
-  void Build(Window& window, int first) const {
-    for (int k = 0; k < kFrames; ++k) {
-      const StateId id(k);
-      const tools::GroundTruthState& gt = NearestGroundTruth(frames[first + k].t_ns);
-      State& s = window.AddState(id, frames[first + k].t_ns);
-      s.SetPose(gt.p_w_b, gt.q_w_b);
-      s.SetSpeedBias(gt.v_w_b, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-      if (k == 0) {
-        StatePrior prior;
-        prior.pose_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e-6;
-        prior.speed_bias_sigma << Eigen::Vector3d::Constant(0.1), Eigen::Vector3d::Constant(0.01),
-            Eigen::Vector3d::Constant(0.1);
-        window.AddStatePrior(id, prior);
-      } else {
-        window.AddImuFactor(StateId(k - 1), id,
-                            PreintegrateBetween(sim.dataset.imu, frames[first + k - 1].t_ns, frames[first + k].t_ns,
-                                                ImuBias{}, sim.dataset.imu_calibration));
-      }
-      AddStereoObservations(frames[first + k], id, model, window);
-    }
-  }
+  void Build(Window& window, int first) const { flight.Build(window, model, first, kFrames); }
 };
 
 SolverOptions Converge() {
@@ -88,7 +48,7 @@ double LargestPoseChange(const Window& window, const std::map<StateId, State>& b
 
 void ExpectMarginalizingAtTheOptimumKeepsIt(bool keep_landmarks) {
   static const WindowFixture fixture;
-  Window window(fixture.model, fixture.stereo);
+  Window window(fixture.model, fixture.flight.stereo());
   fixture.Build(window, /*first=*/70);
   window.Solve(Converge());
   const std::map<StateId, State> optimum = window.states();
@@ -123,7 +83,7 @@ TEST(WindowMarginalization, OldestStateKeepingSharedLandmarksLeavesTheOptimumInP
 
 TEST(WindowMarginalization, DroppingALandmarkRemovesItsObservations) {
   static const WindowFixture fixture;
-  Window window(fixture.model, fixture.stereo);
+  Window window(fixture.model, fixture.flight.stereo());
   fixture.Build(window, /*first=*/70);
   const LandmarkId id = window.landmarks().begin()->first;
   const int observations = static_cast<int>(window.landmark(id).observed_from.size());

@@ -24,8 +24,10 @@ DifferencedMotion MeanImuResidual(const std::vector<GroundTruthState>& gt, const
                                   Timestamp from_ns, Timestamp to_ns, double gravity_m_s2) {
   DifferencedMotion mean;
   const double h = static_cast<double>(kStepNs) * 1e-9;
-  for (const ImuSample& sample : imu) {
-    if (sample.t_ns < from_ns || sample.t_ns > to_ns) continue;
+  auto first = std::lower_bound(imu.begin(), imu.end(), from_ns,
+                                [](const ImuSample& s, Timestamp t) { return s.t_ns < t; });
+  for (auto sample_it = first; sample_it != imu.end() && sample_it->t_ns <= to_ns; ++sample_it) {
+    const ImuSample& sample = *sample_it;
     const auto before = InterpolateGroundTruth(gt, sample.t_ns - kStepNs);
     const auto at = InterpolateGroundTruth(gt, sample.t_ns);
     const auto after = InterpolateGroundTruth(gt, sample.t_ns + kStepNs);
