@@ -47,7 +47,7 @@ TriangulationResult TriangulateMultiView(const std::vector<StereoView>& views, c
   if (!p_w) return {std::nullopt, TriangulationFailure::kNoDisparity};
   const Eigen::Isometry3d T_cl_b = stereo.T_b_cl.inverse();
   const double inv_sigma = 1.0 / options.pixel_sigma;
-  Eigen::Matrix3d H;
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
   Eigen::Vector3d r, g;
   Eigen::Matrix3d J;
   double max_error = 0;

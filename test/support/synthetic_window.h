@@ -1,7 +1,7 @@
 #pragma once
 // A synthetic visual-inertial flight (the simulator's room, features at
 // 0.5 px) and windows built from it, shared by the window tests and the
-// micro-benchmarks. Header-only: it needs the whole stack (vio_tools), which
+// micro-benchmarks. Header-only: it needs the simulator (vio_simulator), which
 // the GoogleTest support library does not link.
 #include <algorithm>
 #include <cstdint>
@@ -11,8 +11,8 @@
 #include "vio/estimator/policy.h"
 #include "vio/estimator/window.h"
 #include "vio/frontend/stereo_rectifier.h"
-#include "vio/tools/simulator.h"
-#include "vio/tools/stereo_frames.h"
+#include "vio/simulator/simulator.h"
+#include "vio/dataset/stereo_frames.h"
 
 namespace vio::test {
 

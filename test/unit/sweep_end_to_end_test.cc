@@ -14,7 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "test_data.h"
-#include "vio/tools/simulator.h"
+#include "vio/simulator/simulator.h"
 
 namespace vio::tools {
 namespace {

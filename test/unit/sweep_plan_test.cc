@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "test_data.h"
-#include "vio/tools/sweep.h"
+#include "vio/sweep/sweep.h"
 
 namespace vio::tools {
 namespace {

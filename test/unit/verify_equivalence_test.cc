@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "vio/marginalization/kalman_reference.h"
-#include "vio/tools/verify.h"
+#include "vio/verify/verify.h"
 
 namespace vio::tools {
 namespace {

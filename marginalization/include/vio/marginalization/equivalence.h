@@ -123,7 +123,7 @@ struct MsckfUpdateProblem {
 };
 
 /// One of each, generated together (see RandomLinearGaussianProblems and the
-/// nonlinear generator of vio_tools).
+/// nonlinear generator of vio_verify).
 struct EquivalenceProblems {
   EkfAugmentationProblem ekf_augmentation;
   EkfUpdateProblem ekf_update;

@@ -1,0 +1,123 @@
+// `vio run` end to end on a short synthetic dataset the simulator makes:
+// the SWF tracks the ground truth, and the same command twice writes
+// byte-identical trajectories.
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "test_data.h"
+#include "vio/cli/run.h"
+#include "vio/simulator/simulator.h"
+
+namespace vio::tools {
+namespace {
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+const std::string& SyntheticDataset() {
+  static const std::string dir = [] {
+    SimulatorOptions options;
+    options.output_dir = test::MakeTempDir("run_synthetic") + "/dataset";
+    options.duration_s = 15.0;
+    options.seed = 3;
+    Simulate(options);
+    return options.output_dir;
+  }();
+  return dir;
+}
+
+RunResult RunOnSynthetic(const std::string& output_dir, const std::string& policy = "swf") {
+  RunRequest request;
+  request.dataset_dir = SyntheticDataset();
+  request.output_dir = output_dir;
+  request.show_progress = false;
+  request.config.estimator.policy.policy = policy;
+  return RunDataset(request);
+}
+
+// Every policy runs the whole flight and stays close to the ground truth.
+class EveryPolicy : public ::testing::TestWithParam<std::pair<std::string, double>> {};
+
+TEST_P(EveryPolicy, TracksTheSyntheticFlight) {
+  const auto& [policy, ate_bound_m] = GetParam();
+  const RunResult result = RunOnSynthetic(test::MakeTempDir("run_policy_" + policy), policy);
+  EXPECT_EQ(result.status, "ok") << policy;
+  EXPECT_GE(result.frames_estimated, result.frames - 2) << policy;
+  ASSERT_TRUE(result.evaluation.has_value());
+  EXPECT_LT(result.evaluation->ate.rmse_m, ate_bound_m) << policy;
+}
+
+INSTANTIATE_TEST_SUITE_P(Policies, EveryPolicy,
+                         ::testing::Values(std::make_pair("msckf", 0.05), std::make_pair("fixed_lag", 0.05),
+                                           std::make_pair("keyframe", 0.05)),
+                         [](const auto& info) { return info.param.first; });
+
+// The MSCKF's other use of tracks seen from leaving states (whole tracks,
+// restarted) runs the flight as well.
+TEST(RunSynthetic, MsckfWithWholeTracksTracksTheSyntheticFlight) {
+  RunRequest request;
+  request.dataset_dir = SyntheticDataset();
+  request.output_dir = test::MakeTempDir("run_msckf_whole_track");
+  request.show_progress = false;
+  request.config.estimator.policy.policy = "msckf";
+  request.config.estimator.msckf.msckf_leaving_update = "whole_track";
+  const RunResult result = RunDataset(request);
+  EXPECT_EQ(result.status, "ok");
+  ASSERT_TRUE(result.evaluation.has_value());
+  EXPECT_LE(result.evaluation->ate.rmse_m, 0.05);
+}
+
+TEST(RunSynthetic, SwfTracksTheSyntheticFlight) {
+  const std::string out = test::MakeTempDir("run_synthetic_out");
+  const RunResult result = RunOnSynthetic(out);
+  EXPECT_EQ(result.status, "ok");
+  EXPECT_GE(result.frames_estimated, result.frames - 2);
+  ASSERT_TRUE(result.evaluation.has_value());
+  EXPECT_LT(result.evaluation->ate.rmse_m, 0.03);
+  EXPECT_LT(result.evaluation->ate.rot_rmse_deg, 1.0);
+  for (const char* file : {"trajectory.txt", "summary.json", "timing.csv", "config.yaml"}) {
+    EXPECT_TRUE(std::filesystem::exists(out + "/" + file)) << file;
+  }
+}
+
+// `vio run` twice as separate processes, exactly as a user would.
+TEST(RunSynthetic, SameCommandTwiceGivesByteIdenticalTrajectories) {
+  const std::string a = test::MakeTempDir("run_det_a");
+  const std::string b = test::MakeTempDir("run_det_b");
+  for (const std::string& out : {a, b}) {
+    const std::string command = std::string(VIO_BINARY) + " run --dataset=" + SyntheticDataset() +
+                                " --output_dir=" + out + " > " + out + "/log.txt 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  }
+  const std::string trajectory = ReadFile(a + "/trajectory.txt");
+  EXPECT_GT(trajectory.size(), 1000u);
+  EXPECT_EQ(trajectory, ReadFile(b + "/trajectory.txt"));
+}
+
+TEST(RunSynthetic, DatasetWithoutFeaturesIsAClearError) {
+  const std::string dir = test::MakeTempDir("run_nofeatures");
+  EurocDataset dataset = ReadEuroc(SyntheticDataset());
+  dataset.features.clear();
+  WriteEuroc(dataset, dir);
+  RunRequest request;
+  request.dataset_dir = dir;
+  request.output_dir = dir + "/out";
+  request.show_progress = false;
+  try {
+    RunDataset(request);
+    FAIL() << "ran without features";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("features0/data.csv"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace vio::tools

@@ -1,0 +1,44 @@
+#pragma once
+// The configuration of one `vio run`: built-in defaults, then the run's YAML
+// file, then command-line flags of the same names.
+#include <string>
+
+#include "vio/estimator/estimator_options.h"
+#include "vio/frontend/frontend_options.h"
+#include "vio/cli/options_registry.h"
+
+namespace vio::tools {
+
+/// Where calibration comes from.
+struct CalibrationOptions {
+  /// Folder holding mav0/{cam0,cam1,imu0}/sensor.yaml; empty = the dataset's own.
+  std::string calibration;
+
+  template <class V>
+  void Visit(V& v) {
+    v("calibration", calibration,
+      "folder whose mav0/{cam0,cam1,imu0}/sensor.yaml calibrate the run; empty = the dataset's own");
+  }
+};
+
+struct RunConfig {
+  CalibrationOptions calibration;
+  FrontendOptions frontend;
+  EstimatorOptions estimator;
+};
+
+/// Binds every field of `config` to `registry` under its YAML section.
+void BindRunConfig(RunConfig* config, OptionRegistry* registry);
+
+/// Registers one command-line flag per RunConfig field (defaults: built-in).
+/// Call once, before gflags parses the command line.
+void RegisterRunConfigFlags();
+
+/// Defaults, then `yaml_path` (when not empty), then the flags given on the
+/// command line. Throws ConfigError on an unknown key or bad value.
+RunConfig LoadRunConfig(const std::string& yaml_path);
+
+/// The effective configuration as YAML (written next to every run's results).
+std::string RunConfigToYaml(RunConfig config);
+
+}  // namespace vio::tools

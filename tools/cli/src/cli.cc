@@ -1,0 +1,119 @@
+#include "vio/cli/cli.h"
+
+#include <cstring>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
+#include "commands.h"
+#include "vio/cli/run_config.h"
+
+DEFINE_string(output_dir, "", "output folder of the command (created when missing)");
+
+namespace vio::tools {
+namespace {
+
+void PrintTopLevelHelp(std::ostream& os) {
+  os << "vio: stereo-inertial sliding-window estimation (one cost, many policies)\n\n"
+        "usage: vio <command> [--flag=value ...]\n\ncommands:\n";
+  for (const Subcommand& cmd : Subcommands()) {
+    os << "  " << cmd.name << std::string(12 - std::min<size_t>(11, cmd.name.size()), ' ')
+       << cmd.summary << "\n";
+  }
+  os << "\n`vio <command> --help` lists the command's flags.\n";
+}
+
+// The flags a command takes: those defined in its own source file
+// (cmd_<name>.cc) and every estimator/front-end option (registered from the
+// Options structs, file name "options/<section>").
+void PrintCommandHelp(const Subcommand& cmd, std::ostream& os) {
+  os << "vio " << cmd.name << ": " << cmd.summary << "\n\nusage: " << cmd.usage << "\n\nflags:\n";
+  std::vector<gflags::CommandLineFlagInfo> flags;
+  gflags::GetAllFlags(&flags);
+  const std::string own = "cmd_" + cmd.name + ".cc";
+  const std::string shared = "cli.cc";
+  for (const auto& f : flags) {
+    const bool mine = f.filename.size() >= own.size() &&
+                      f.filename.compare(f.filename.size() - own.size(), own.size(), own) == 0;
+    const bool common = f.filename.size() >= shared.size() &&
+                        f.filename.compare(f.filename.size() - shared.size(), shared.size(), shared) == 0;
+    const bool option = f.filename.rfind("options/", 0) == 0;
+    if (!mine && !common && !(option && cmd.takes_run_config)) continue;
+    os << "  --" << f.name << "=" << f.default_value << " (" << f.type << ")\n      " << f.description
+       << "\n";
+  }
+}
+
+const Subcommand* FindSubcommand(const std::string& name) {
+  for (const Subcommand& cmd : Subcommands()) {
+    if (cmd.name == name) return &cmd;
+  }
+  return nullptr;
+}
+
+bool WantsHelp(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+const std::vector<Subcommand>& Subcommands() {
+  static const std::vector<Subcommand> commands = {
+      {"run", "run the estimator over one EuRoC-format dataset",
+       "vio run --dataset=DIR --output_dir=DIR [--config=FILE] [--policy=swf --window_size=10 ...]", &RunMain,
+       /*takes_run_config=*/true},
+      {"simulate", "generate a synthetic or hybrid EuRoC-format dataset",
+       "vio simulate --output_dir=DIR [--from=EUROC_DIR] [--camera=features|images]", &SimulateMain},
+      {"eval", "trajectory error (ATE, RPE) of an estimate against ground truth",
+       "vio eval --estimate=FILE --groundtruth=FILE_OR_DIR [--alignment=posyaw|se3|sim3|none] [--json=FILE]",
+       &EvalMain},
+      {"verify", "check the paper's filter = optimization equivalence theorems on random problems",
+       "vio verify [--seed=N] [--num_landmarks=N] [--num_poses=N] [--trials=N]", &VerifyMain},
+      {"sweep", "run every dataset x policy x window size, N at a time; table, CSV and plots",
+       "vio sweep --datasets=DIR,... --policies=swf,... --window_sizes=5,10,... --output_dir=DIR [--jobs=N] "
+       "[--config=FILE] [--extra_flags=\"--init=groundtruth ...\"] [--emit_jobs | --collect_only]",
+       &SweepMain, /*takes_run_config=*/true},
+  };
+  return commands;
+}
+
+int RunCli(int argc, char** argv) {
+  google::InitGoogleLogging(argv[0]);
+  FLAGS_logtostderr = true;
+  RegisterRunConfigFlags();
+  if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0 ||
+      std::strcmp(argv[1], "help") == 0) {
+    PrintTopLevelHelp(std::cout);
+    return argc < 2 ? 2 : 0;
+  }
+  const Subcommand* cmd = FindSubcommand(argv[1]);
+  if (cmd == nullptr) {
+    std::cerr << "vio: unknown command '" << argv[1] << "'\n\n";
+    PrintTopLevelHelp(std::cerr);
+    return 2;
+  }
+  // argv[1] is the command: gflags parses the rest.
+  int sub_argc = argc - 1;
+  char** sub_argv = argv + 1;
+  if (WantsHelp(sub_argc, sub_argv)) {
+    PrintCommandHelp(*cmd, std::cout);
+    return 0;
+  }
+  gflags::SetUsageMessage(cmd->usage);
+  gflags::ParseCommandLineFlags(&sub_argc, &sub_argv, /*remove_flags=*/true);
+  std::vector<std::string> args(sub_argv + 1, sub_argv + sub_argc);
+  try {
+    return cmd->main(args);
+  } catch (const std::exception& e) {
+    std::cerr << "vio " << cmd->name << ": error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace vio::tools

@@ -1,0 +1,109 @@
+// `vio eval`: trajectory error (ATE, RPE) of an estimate against ground truth.
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gflags/gflags.h>
+
+#include "commands.h"
+#include "vio/evaluation/trajectory_eval.h"
+
+DEFINE_string(estimate, "", "estimated trajectory, TUM text: t[s] x y z qx qy qz qw per line");
+DEFINE_string(groundtruth, "",
+              "ground truth: EuRoC sequence folder, an ASL data.csv (17 columns) or a TUM text file");
+DEFINE_string(alignment, "posyaw", "estimate-to-ground-truth alignment: posyaw|se3|sim3|none");
+DEFINE_string(rpe_lengths, "1,2,5,10",
+              "RPE sub-trajectory lengths along the ground truth [m], comma separated");
+DEFINE_string(json, "", "also write the report as JSON to this file (optional)");
+
+namespace vio::tools {
+namespace {
+
+struct EvalRequest {
+  std::string estimate_path;
+  std::string groundtruth_path;
+  std::string json_path;  ///< empty: no JSON
+  EvaluationOptions options;
+};
+
+std::vector<double> ParseLengths(const std::string& text) {
+  std::vector<double> lengths_m;
+  std::stringstream ss(text);
+  std::string token;
+  while (std::getline(ss, token, ',')) {
+    size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(token, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != token.size() || !(value > 0.0)) {
+      throw std::invalid_argument("--rpe_lengths: '" + token + "' is not a length > 0 [m]");
+    }
+    lengths_m.push_back(value);
+  }
+  return lengths_m;
+}
+
+EvalRequest RequestFromFlags(const std::vector<std::string>& args) {
+  if (!args.empty()) throw std::invalid_argument("unexpected argument '" + args.front() + "'");
+  if (FLAGS_estimate.empty()) throw std::invalid_argument("--estimate=FILE is required");
+  if (FLAGS_groundtruth.empty()) throw std::invalid_argument("--groundtruth=FILE_OR_DIR is required");
+  if (!std::filesystem::is_regular_file(FLAGS_estimate)) {
+    throw std::invalid_argument("estimate file not found: " + FLAGS_estimate);
+  }
+  EvalRequest request;
+  request.estimate_path = FLAGS_estimate;
+  request.groundtruth_path = FLAGS_groundtruth;
+  request.json_path = FLAGS_json;
+  request.options.alignment = ParseAlignment(FLAGS_alignment);
+  request.options.rpe_lengths_m = ParseLengths(FLAGS_rpe_lengths);
+  return request;
+}
+
+void WriteJson(const TrajectoryEvaluation& evaluation, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write " + path);
+  out << ToJson(evaluation) << "\n";
+  if (!out) throw std::runtime_error("error writing " + path);
+}
+
+void RunEval(const EvalRequest& request) {
+  const std::vector<GroundTruthState> estimate = ReadTumTrajectory(request.estimate_path);
+  const std::vector<GroundTruthState> groundtruth = ReadGroundTruthPath(request.groundtruth_path);
+  const TrajectoryEvaluation evaluation = EvaluateTrajectory(estimate, groundtruth, request.options);
+  std::cout << "estimate    " << request.estimate_path << " (" << estimate.size() << " poses)\n"
+            << "groundtruth " << request.groundtruth_path << " (" << groundtruth.size()
+            << " samples)\n"
+            << ToText(evaluation);
+  if (!request.json_path.empty()) {
+    WriteJson(evaluation, request.json_path);
+    std::cout << "json        " << request.json_path << "\n";
+  }
+}
+
+}  // namespace
+
+int EvalMain(const std::vector<std::string>& args) {
+  EvalRequest request;
+  try {
+    request = RequestFromFlags(args);
+  } catch (const std::exception& e) {
+    std::cerr << "vio eval: " << e.what() << "\n(see vio eval --help)\n";
+    return 2;
+  }
+  try {
+    RunEval(request);
+  } catch (const std::exception& e) {
+    std::cerr << "vio eval: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace vio::tools

@@ -1,0 +1,32 @@
+// `vio run`: the estimator over one dataset.
+#include <iostream>
+
+#include <gflags/gflags.h>
+
+#include "commands.h"
+#include "vio/cli/run.h"
+
+DEFINE_string(dataset, "", "EuRoC ASL dataset folder (holding mav0/) with features0/data.csv");
+DEFINE_string(config, "", "run configuration YAML (e.g. config/euroc_stereo.yaml); flags override it");
+
+namespace vio::tools {
+
+int RunMain(const std::vector<std::string>& args) {
+  if (!args.empty() || FLAGS_dataset.empty() || FLAGS_output_dir.empty()) {
+    std::cerr << "vio run: --dataset and --output_dir are required (see `vio run --help`)\n";
+    return 2;
+  }
+  RunRequest request;
+  request.dataset_dir = FLAGS_dataset;
+  request.output_dir = FLAGS_output_dir;
+  request.config = LoadRunConfig(FLAGS_config);
+  const RunResult result = RunDataset(request);
+  std::cout << "status " << result.status << ": " << result.frames_estimated << "/" << result.frames
+            << " frames, " << result.ms_per_frame << " ms per frame, " << result.real_time_factor
+            << "x real time\n";
+  if (result.evaluation) std::cout << ToText(*result.evaluation);
+  std::cout << "results in " << request.output_dir << "\n";
+  return result.status == "ok" ? 0 : 1;
+}
+
+}  // namespace vio::tools

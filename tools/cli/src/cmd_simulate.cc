@@ -1,0 +1,123 @@
+// `vio simulate`: writes a synthetic or hybrid EuRoC ASL folder.
+#include <cmath>
+#include <cstdint>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gflags/gflags.h>
+
+#include "commands.h"
+#include "vio/dataset/euroc_dataset.h"
+#include "vio/cli/progress.h"
+#include "vio/simulator/simulator.h"
+
+// --output_dir is shared with `vio run` and defined in cmd_run.cc.
+DECLARE_string(output_dir);
+DEFINE_string(from, "", "hybrid mode: real EuRoC ASL folder whose IMU, ground truth and calibration are used");
+DEFINE_string(camera, "features", "camera output: features (features0/data.csv) or images (cam0/cam1 PNGs)");
+DEFINE_uint64(seed, 1, "seed of every random draw; same seed, byte-identical output");
+DEFINE_double(duration_s, 60.0, "synthetic flight length including the 3 s static start [s]");
+DEFINE_double(pixel_noise, 0.5, "feature pixel noise, standard deviation per coordinate [px]");
+DEFINE_double(outlier_rate, 0.0, "probability that a feature observation is a random pixel [0, 1]");
+DEFINE_int32(max_features, 150, "feature budget per frame (cam0 tracks)");
+DEFINE_string(room_size, "8,8,4", "room extent x,y,z [m] (grown to enclose a hybrid trajectory)");
+DEFINE_double(landmark_density, 10.0, "landmarks per square metre of wall, floor, ceiling and box");
+DEFINE_int32(num_boxes, 8, "clutter boxes on the floor");
+DEFINE_double(min_range, 0.25, "nearest observable landmark [m]");
+DEFINE_double(max_range, 20.0, "farthest observable landmark [m]");
+DEFINE_double(max_speed, 2.0, "synthetic flight speed limit [m/s]");
+DEFINE_double(max_rotation_rate, 1.5, "synthetic flight angular rate limit [rad/s]");
+DEFINE_double(sim_imu_noise, 1.0, "synthetic IMU noise and bias random walk, times the EuRoC densities");
+DEFINE_double(image_noise, 1.0, "rendered image noise, standard deviation [grey levels]");
+DEFINE_int32(png_compression, 1, "PNG compression level of rendered images, 0..9");
+
+namespace vio::tools {
+namespace {
+
+Eigen::Vector3d ParseVector3(const std::string& flag, const std::string& text) {
+  std::vector<double> values;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || !std::isfinite(value)) {
+      throw std::invalid_argument("--" + flag + ": '" + item + "' is not a number (expected x,y,z)");
+    }
+    values.push_back(value);
+  }
+  if (values.size() != 3) {
+    throw std::invalid_argument("--" + flag + "=" + text + ": expected three comma-separated numbers x,y,z");
+  }
+  return Eigen::Vector3d(values[0], values[1], values[2]);
+}
+
+SimCameraOutput ParseCameraOutput(const std::string& text) {
+  if (text == "features") return SimCameraOutput::kFeatures;
+  if (text == "images") return SimCameraOutput::kImages;
+  throw std::invalid_argument("--camera=" + text + ": expected 'features' or 'images'");
+}
+
+SimulatorOptions OptionsFromFlags() {
+  SimulatorOptions options;
+  options.output_dir = FLAGS_output_dir;
+  options.from_euroc_dir = FLAGS_from;
+  options.camera_output = ParseCameraOutput(FLAGS_camera);
+  options.seed = FLAGS_seed;
+  options.duration_s = FLAGS_duration_s;
+  options.features.pixel_noise_px = FLAGS_pixel_noise;
+  options.features.outlier_rate = FLAGS_outlier_rate;
+  options.features.max_features = FLAGS_max_features;
+  options.features.min_range_m = FLAGS_min_range;
+  options.features.max_range_m = FLAGS_max_range;
+  options.scene.room_size_m = ParseVector3("room_size", FLAGS_room_size);
+  options.scene.landmark_density_per_m2 = FLAGS_landmark_density;
+  options.scene.num_boxes = FLAGS_num_boxes;
+  options.trajectory.max_speed_m_s = FLAGS_max_speed;
+  options.trajectory.max_rotation_rate_rad_s = FLAGS_max_rotation_rate;
+  options.imu.noise_scale = FLAGS_sim_imu_noise;
+  options.render.image_noise_sigma = FLAGS_image_noise;
+  options.png_compression = FLAGS_png_compression;
+  return options;
+}
+
+}  // namespace
+
+int SimulateMain(const std::vector<std::string>& args) {
+  if (!args.empty()) {
+    std::cerr << "vio simulate: unexpected argument '" << args.front() << "' (see `vio simulate --help`)\n";
+    return 2;
+  }
+  try {
+    const SimulatorOptions options = OptionsFromFlags();
+    if (options.output_dir.empty()) {
+      std::cerr << "vio simulate: --output_dir is required (see `vio simulate --help`)\n";
+      return 2;
+    }
+    std::optional<ProgressBar> bar;  // images mode only: one tick per written image
+    const SimulationSummary summary = Simulate(options, [&bar](std::int64_t done, std::int64_t total) {
+      if (!bar) bar.emplace(total, "images");
+      bar->Update(done);
+      if (done == total) bar->Finish();
+    });
+    std::cout << FormatSummary(summary, options.output_dir);
+    return 0;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "vio simulate: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "vio simulate: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace vio::tools

@@ -1,0 +1,35 @@
+#pragma once
+// Where a run's stereo observations come from: the front end as seen by
+// `vio run`. One implementation per front end; the estimator never knows
+// which one ran.
+#include <memory>
+#include <string>
+
+#include "vio/estimator/estimator.h"
+#include "vio/frontend/stereo_rectifier.h"
+#include "vio/dataset/euroc_dataset.h"
+#include "vio/frontend/frontend_options.h"
+
+namespace vio::tools {
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  /// Number of frames (cam0 stamps).
+  virtual size_t size() const = 0;
+  /// Stamp of frame k.
+  virtual Timestamp time(size_t k) const = 0;
+  /// The observations of frame k. Called once per frame in order, after the
+  /// IMU up to the frame was given to `estimator` (which can predict the body
+  /// pose at the frame and knows the current landmark estimates).
+  virtual StereoFrame Frame(size_t k, const Estimator& estimator) = 0;
+  /// Counts for summary.json's "frontend" object (a JSON object).
+  virtual std::string ReportJson() const = 0;
+};
+
+/// The source `options.frontend` names. Throws
+/// std::runtime_error when the dataset lacks what it needs.
+std::unique_ptr<FrameSource> MakeFrameSource(const FrontendOptions& options, const EurocDataset& dataset,
+                                             const frontend::StereoRectifier& rectifier);
+
+}  // namespace vio::tools

@@ -1,0 +1,31 @@
+#pragma once
+// The `features` front end: a dataset's features0 observations (distorted
+// pixels of cam0 and cam1) turned into the estimator's StereoFrames of
+// rectified (u_L, u_R, v) measurements.
+#include <vector>
+
+#include "vio/frontend/stereo_rectifier.h"
+#include "vio/dataset/euroc_dataset.h"
+
+namespace vio::tools {
+
+/// What happened to the observations (nothing is dropped without a count).
+struct StereoFramesReport {
+  int frames = 0;                  ///< frames produced (one per cam0 stamp)
+  int stereo_observations = 0;     ///< landmarks seen in both cameras, kept
+  int left_only = 0;               ///< seen in cam0 only (not used by the stereo model)
+  int right_only = 0;              ///< seen in cam1 only (not used)
+  int rejected_epipolar = 0;       ///< rectified rows differ by more than the bound
+  int rejected_disparity = 0;      ///< disparity <= 0 (behind or at infinity)
+  int unrectifiable = 0;           ///< a pixel that cannot be undistorted
+  int observations_off_frames = 0; ///< feature rows whose stamp is no cam0 frame
+};
+
+/// One StereoFrame per cam0 frame stamp (empty frames included), observations
+/// sorted by landmark id.
+std::vector<StereoFrame> StereoFramesFromFeatures(const std::vector<FeatureObservation>& features,
+                                                  const std::vector<CameraFrame>& cam0_frames,
+                                                  const frontend::StereoRectifier& rectifier,
+                                                  double max_epipolar_px, StereoFramesReport* report);
+
+}  // namespace vio::tools

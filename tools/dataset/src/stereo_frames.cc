@@ -1,0 +1,58 @@
+#include "vio/dataset/stereo_frames.h"
+
+#include <cmath>
+#include <map>
+
+namespace vio::tools {
+namespace {
+
+struct PixelPair {
+  std::optional<Eigen::Vector2d> uv[2];
+};
+
+// One frame's rows (feature id -> pixels in cam0 / cam1) to measurements.
+void AddStereoObservations(const std::map<std::int64_t, PixelPair>& rows,
+                           const frontend::StereoRectifier& rectifier, double max_epipolar_px, StereoFrame* frame,
+                           StereoFramesReport* report) {
+  for (const auto& [id, pair] : rows) {
+    if (!pair.uv[1]) { ++report->left_only; continue; }
+    if (!pair.uv[0]) { ++report->right_only; continue; }
+    const std::optional<Eigen::Vector2d> left = rectifier.Rectify(0, *pair.uv[0]);
+    const std::optional<Eigen::Vector2d> right = rectifier.Rectify(1, *pair.uv[1]);
+    if (!left || !right) { ++report->unrectifiable; continue; }
+    if (std::abs(left->y() - right->y()) > max_epipolar_px) { ++report->rejected_epipolar; continue; }
+    if (left->x() - right->x() <= 0) { ++report->rejected_disparity; continue; }
+    StereoObservation obs;
+    obs.landmark = LandmarkId(id);
+    obs.z_px = Eigen::Vector3d(left->x(), right->x(), 0.5 * (left->y() + right->y()));
+    frame->observations.push_back(obs);
+    ++report->stereo_observations;
+  }
+}
+
+}  // namespace
+
+std::vector<StereoFrame> StereoFramesFromFeatures(const std::vector<FeatureObservation>& features,
+                                                  const std::vector<CameraFrame>& cam0_frames,
+                                                  const frontend::StereoRectifier& rectifier,
+                                                  double max_epipolar_px, StereoFramesReport* report) {
+  *report = StereoFramesReport{};
+  std::map<Timestamp, std::map<std::int64_t, PixelPair>> by_time;
+  for (const CameraFrame& f : cam0_frames) by_time[f.t_ns];
+  for (const FeatureObservation& obs : features) {
+    auto it = by_time.find(obs.t_ns);
+    if (it == by_time.end()) { ++report->observations_off_frames; continue; }
+    it->second[obs.feature_id].uv[obs.camera] = obs.uv_px;
+  }
+  std::vector<StereoFrame> frames;
+  frames.reserve(by_time.size());
+  for (const auto& [t_ns, rows] : by_time) {
+    StereoFrame& frame = frames.emplace_back();
+    frame.t_ns = t_ns;
+    AddStereoObservations(rows, rectifier, max_epipolar_px, &frame, report);
+  }
+  report->frames = static_cast<int>(frames.size());
+  return frames;
+}
+
+}  // namespace vio::tools

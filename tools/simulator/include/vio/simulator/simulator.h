@@ -1,0 +1,105 @@
+#pragma once
+// `vio simulate`: synthetic and hybrid EuRoC-format datasets.
+//
+//  * synthetic: a smooth closed flight (trajectory.h) through a textured
+//    room with clutter (scene.h), IMU synthesized from the analytic
+//    trajectory with EuRoC noise (imu.h), the real EuRoC V2_01
+//    calibration, camera frames at the camera rate.
+//  * hybrid (from_euroc_dir set): the real IMU, ground truth and
+//    calibration of an ASL folder copied unchanged; the cameras see the
+//    synthetic room along the real ground truth (interpolated at the real
+//    cam0 stamps; frames outside the ground truth are dropped).
+// The camera side is either feature tracks (features0/data.csv,
+// features.h) or rendered stereo PNG images (cam0/cam1, render.h).
+// Output is deterministic for a given seed.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "vio/dataset/euroc_dataset.h"
+#include "vio/simulator/features.h"
+#include "vio/simulator/imu.h"
+#include "vio/simulator/render.h"
+#include "vio/simulator/scene.h"
+#include "vio/simulator/trajectory.h"
+
+namespace vio::tools {
+
+enum class SimCameraOutput { kFeatures, kImages };
+
+struct SimulatorOptions {
+  /// Folder to write (the one that will hold mav0/); required by Simulate.
+  std::string output_dir;
+  /// ASL folder of a real sequence for hybrid mode; empty = synthetic.
+  std::string from_euroc_dir;
+  /// What the cameras produce.
+  SimCameraOutput camera_output = SimCameraOutput::kFeatures;
+  /// Seed of every random draw (std::mt19937_64).
+  std::uint64_t seed = 1;
+  /// Synthetic flight length including the initial static period [s].
+  double duration_s = 60.0;
+  /// Room, clutter and landmarks.
+  SceneOptions scene;
+  /// Shape limits of the synthetic flight (centre and extents are derived
+  /// from the room: centred, keeping flight_wall_clearance_m to the walls).
+  SyntheticTrajectoryOptions trajectory;
+  /// Horizontal distance the synthetic flight keeps to the walls [m].
+  double flight_wall_clearance_m = 1.5;
+  /// Synthetic IMU rate, noise densities and initial biases (defaults: EuRoC imu0).
+  ImuSynthesisOptions imu;
+  /// Feature tracks (features mode).
+  FeatureSimOptions features;
+  /// Image rendering (images mode; texture seed derived from `seed`).
+  RenderOptions render;
+  /// PNG compression level 0..9 of rendered images (1: fast, larger files).
+  int png_compression = 1;
+};
+
+/// Everything simulated, in memory.
+struct Simulation {
+  EurocDataset dataset;            ///< what WriteEuroc writes (features when in features mode)
+  Scene scene;                     ///< the world; landmark index = feature_id
+  std::vector<FramePose> frames;   ///< body pose at each camera frame
+  FeatureSimulation features;      ///< per-frame counts and track lengths (features mode)
+};
+
+struct SimulationSummary {
+  bool hybrid = false;
+  SimCameraOutput camera_output = SimCameraOutput::kFeatures;
+  int frames = 0;
+  int imu_samples = 0;
+  int landmarks = 0;
+  double features_per_frame = 0.0;         ///< cam0 observations per frame
+  double stereo_features_per_frame = 0.0;  ///< landmarks seen in both cameras per frame
+  double median_track_length = 0.0;        ///< [frames]
+  double seconds = 0.0;                    ///< wall time [s]
+};
+
+/// The EuRoC V2_01 calibration (cam0, cam1: pinhole radial-tangential,
+/// 752 x 480, 20 Hz, real T_BS) used in synthetic mode.
+std::array<CameraCalibration, 2> EurocStereoCalibration();
+
+/// Simulates in memory (features computed in features mode; images are not
+/// rendered here). Throws std::invalid_argument on bad options and
+/// DatasetError when the hybrid source cannot be read.
+Simulation BuildSimulation(const SimulatorOptions& options);
+
+/// Told how many of `total` images are written, after each one (images mode).
+using RenderProgress = std::function<void(std::int64_t done, std::int64_t total)>;
+
+/// Writes the ASL folder (WriteEuroc) and, in images mode, renders and
+/// writes cam0/cam1 PNGs, calling `progress` (when set) after each image.
+/// Throws std::invalid_argument on an empty output_dir, std::runtime_error
+/// when an image cannot be written.
+void WriteSimulation(const Simulation& simulation, const SimulatorOptions& options,
+                     const RenderProgress& progress = {});
+
+/// BuildSimulation + WriteSimulation, timed.
+SimulationSummary Simulate(const SimulatorOptions& options, const RenderProgress& progress = {});
+
+/// One paragraph for the command line.
+std::string FormatSummary(const SimulationSummary& summary, const std::string& output_dir);
+
+}  // namespace vio::tools

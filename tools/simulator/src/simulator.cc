@@ -1,0 +1,226 @@
+#include "vio/simulator/simulator.h"
+
+#include <chrono>
+#include <filesystem>
+#include <iomanip>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+
+#include <glog/logging.h>
+#include <opencv2/imgcodecs.hpp>
+
+
+namespace vio::tools {
+namespace {
+
+/// Start of the synthetic clock (an arbitrary epoch) [ns].
+constexpr Timestamp kSyntheticStartNs = 1'600'000'000'000'000'000;
+
+/// A ground-truth step further than this from its own velocity is reported as
+/// a jump [m/s]: 2.5 cm in one 5 ms sample, above the sample noise of the
+/// EuRoC references (MH_04's laser-tracker positions reach 2 m/s).
+constexpr double kMaxGroundTruthVelocityMismatch = 5.0;
+
+Eigen::Isometry3d FromRowMajor(const std::array<double, 12>& m) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) T.matrix()(r, c) = m[4 * r + c];
+  }
+  return T;
+}
+
+void CheckOptions(const SimulatorOptions& options) {
+  if (options.from_euroc_dir.empty() && !(options.duration_s > 0.0)) {
+    throw std::invalid_argument("simulator: duration must be positive, got " +
+                                std::to_string(options.duration_s) + " s");
+  }
+  if (options.png_compression < 0 || options.png_compression > 9) {
+    throw std::invalid_argument("simulator: PNG compression must be in 0..9, got " +
+                                std::to_string(options.png_compression));
+  }
+}
+
+// The flight is centred in the nominal room and keeps the clearance to its walls.
+SyntheticTrajectoryOptions FlightInRoom(const SimulatorOptions& options) {
+  const SceneOptions& scene = options.scene;
+  SyntheticTrajectoryOptions flight = options.trajectory;
+  const double floor_z = scene.room_center_m.z() - 0.5 * scene.room_size_m.z();
+  flight.center_w = Eigen::Vector3d(scene.room_center_m.x(), scene.room_center_m.y(),
+                                    floor_z + 0.4 * scene.room_size_m.z());
+  flight.half_extent_m = Eigen::Vector3d(0.5 * scene.room_size_m.x() - options.flight_wall_clearance_m,
+                                         0.5 * scene.room_size_m.y() - options.flight_wall_clearance_m,
+                                         0.2 * scene.room_size_m.z());
+  if (flight.half_extent_m.minCoeff() < 0.1) {
+    throw std::invalid_argument(
+        "simulator: room too small for the synthetic flight (room size minus twice the wall clearance "
+        "must be at least 0.2 m in x and y)");
+  }
+  return flight;
+}
+
+std::vector<CameraFrame> FrameRows(const std::vector<FramePose>& frames) {
+  std::vector<CameraFrame> rows;
+  for (const FramePose& f : frames) rows.push_back({f.t_ns, std::to_string(f.t_ns) + ".png"});
+  return rows;
+}
+
+std::vector<Eigen::Vector3d> PathOf(const std::vector<GroundTruthState>& groundtruth) {
+  std::vector<Eigen::Vector3d> path;
+  for (const GroundTruthState& s : groundtruth) path.push_back(s.p_w_b);
+  return path;
+}
+
+void BuildSyntheticMotion(const SimulatorOptions& options, std::mt19937_64* rng, Simulation* sim) {
+  const SyntheticTrajectory trajectory(FlightInRoom(options));
+  ImuSynthesis imu = SynthesizeImu(trajectory, kSyntheticStartNs, options.duration_s, options.imu, rng);
+  EurocDataset& dataset = sim->dataset;
+  dataset.imu_calibration = options.imu.calibration;
+  dataset.imu = std::move(imu.imu);
+  dataset.groundtruth = std::move(imu.groundtruth);
+  const std::array<CameraCalibration, 2> cameras = EurocStereoCalibration();
+  dataset.cameras[0] = cameras[0];
+  dataset.cameras[1] = cameras[1];
+  const Timestamp period_ns = SecondsToNanos(1.0 / cameras[0].rate_hz);
+  for (Timestamp offset_ns = 0; offset_ns <= SecondsToNanos(options.duration_s); offset_ns += period_ns) {
+    const KinematicState state = trajectory.Evaluate(NanosToSeconds(offset_ns));
+    FramePose frame;
+    frame.t_ns = kSyntheticStartNs + offset_ns;
+    frame.T_w_b.linear() = state.q_w_b.toRotationMatrix();
+    frame.T_w_b.translation() = state.p_w_b;
+    sim->frames.push_back(frame);
+  }
+}
+
+void BuildHybridMotion(const SimulatorOptions& options, Simulation* sim) {
+  EurocReadOptions read;
+  read.read_features = false;
+  read.check_images = false;
+  EurocDataset& dataset = sim->dataset;
+  dataset = ReadEuroc(options.from_euroc_dir, read);
+  if (dataset.groundtruth.empty() || dataset.frames[0].empty()) {
+    throw DatasetError(options.from_euroc_dir + ": hybrid mode needs ground truth and cam0/data.csv");
+  }
+  for (const GroundTruthJump& jump : FindGroundTruthJumps(dataset.groundtruth, kMaxGroundTruthVelocityMismatch)) {
+    LOG(WARNING) << std::fixed << std::setprecision(3) << options.from_euroc_dir << ": the ground truth jumps "
+                 << jump.step_m << " m at t=" << NanosToSeconds(jump.t_ns) << " s (" << jump.speed_m_s << " m/s against its velocity of "
+                 << jump.velocity_m_s << " m/s); the simulated cameras follow the jump, the real IMU does not";
+  }
+  dataset.root.clear();
+  dataset.features.clear();
+  dataset.has_images = false;
+  for (const CameraFrame& row : dataset.frames[0]) {
+    if (const std::optional<Eigen::Isometry3d> T_w_b = InterpolatePose(dataset.groundtruth, row.t_ns)) {
+      sim->frames.push_back({row.t_ns, *T_w_b});
+    }
+  }
+}
+
+SimulationSummary Summarize(const Simulation& sim, const SimulatorOptions& options) {
+  SimulationSummary summary;
+  summary.hybrid = !options.from_euroc_dir.empty();
+  summary.camera_output = options.camera_output;
+  summary.frames = static_cast<int>(sim.frames.size());
+  summary.imu_samples = static_cast<int>(sim.dataset.imu.size());
+  summary.landmarks = static_cast<int>(sim.scene.landmarks.size());
+  const std::vector<int>& cam0 = sim.features.cam0_count;
+  const std::vector<int>& stereo = sim.features.stereo_count;
+  if (!cam0.empty()) {
+    summary.features_per_frame = std::accumulate(cam0.begin(), cam0.end(), 0.0) / cam0.size();
+    summary.stereo_features_per_frame = std::accumulate(stereo.begin(), stereo.end(), 0.0) / stereo.size();
+  }
+  summary.median_track_length = MedianTrackLength(sim.features);
+  return summary;
+}
+
+void WriteImages(const Simulation& sim, const SimulatorOptions& options, const RenderProgress& progress) {
+  const std::vector<int> png = {cv::IMWRITE_PNG_COMPRESSION, options.png_compression};
+  RenderOptions render = options.render;
+  render.texture_seed = options.seed;
+  const std::int64_t total = 2 * static_cast<std::int64_t>(sim.frames.size());
+  cv::Mat image;
+  for (int k = 0; k < 2; ++k) {
+    const CameraCalibration& camera = sim.dataset.cameras[k];
+    const SceneRenderer renderer(sim.scene, camera, render);
+    const std::string folder = options.output_dir + "/mav0/cam" + std::to_string(k) + "/data";
+    std::filesystem::create_directories(folder);
+    for (std::size_t i = 0; i < sim.frames.size(); ++i) {
+      renderer.Render(sim.frames[i].T_w_b * camera.T_b_c, options.seed * 1'000'003ULL + 2 * i + k, &image);
+      const std::string path = folder + "/" + sim.dataset.frames[k][i].filename;
+      if (!cv::imwrite(path, image, png)) throw std::runtime_error("simulator: cannot write image " + path);
+      if (progress) progress(static_cast<std::int64_t>(k * sim.frames.size() + i + 1), total);
+    }
+  }
+}
+
+}  // namespace
+
+std::array<CameraCalibration, 2> EurocStereoCalibration() {
+  std::array<CameraCalibration, 2> cameras;
+  cameras[0].intrinsics = Eigen::Vector4d(458.654, 457.296, 367.215, 248.375);
+  cameras[0].distortion = Eigen::Vector4d(-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05);
+  cameras[0].T_b_c = FromRowMajor({0.0148655429818, -0.999880929698, 0.00414029679422, -0.0216401454975,
+                                   0.999557249008, 0.0149672133247, 0.025715529948, -0.064676986768,
+                                   -0.0257744366974, 0.00375618835797, 0.999660727178, 0.00981073058949});
+  cameras[1].intrinsics = Eigen::Vector4d(457.587, 456.134, 379.999, 255.238);
+  cameras[1].distortion = Eigen::Vector4d(-0.28368365, 0.07451284, -0.00010473, -3.55590700e-05);
+  cameras[1].T_b_c = FromRowMajor({0.0125552670891, -0.999755099723, 0.0182237714554, -0.0198435579556,
+                                   0.999598781151, 0.0130119051815, 0.0251588363115, 0.0453689425024,
+                                   -0.0253898008918, 0.0179005838253, 0.999517347078, 0.00786212447038});
+  return cameras;
+}
+
+Simulation BuildSimulation(const SimulatorOptions& options) {
+  CheckOptions(options);
+  std::mt19937_64 rng(options.seed);
+  Simulation sim;
+  if (options.from_euroc_dir.empty()) {
+    BuildSyntheticMotion(options, &rng, &sim);
+  } else {
+    BuildHybridMotion(options, &sim);
+  }
+  sim.dataset.frames[0] = FrameRows(sim.frames);
+  sim.dataset.frames[1] = sim.dataset.frames[0];
+  sim.scene = BuildScene(options.scene, PathOf(sim.dataset.groundtruth), &rng);
+  if (options.camera_output == SimCameraOutput::kFeatures) {
+    sim.features = SimulateFeatures(sim.scene, {sim.dataset.cameras[0], sim.dataset.cameras[1]}, sim.frames,
+                                    options.features, &rng);
+    sim.dataset.features = sim.features.observations;
+  }
+  return sim;
+}
+
+void WriteSimulation(const Simulation& simulation, const SimulatorOptions& options,
+                     const RenderProgress& progress) {
+  if (options.output_dir.empty()) throw std::invalid_argument("simulator: an output folder is required");
+  WriteEuroc(simulation.dataset, options.output_dir);
+  if (options.camera_output == SimCameraOutput::kImages) WriteImages(simulation, options, progress);
+}
+
+SimulationSummary Simulate(const SimulatorOptions& options, const RenderProgress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  if (options.output_dir.empty()) throw std::invalid_argument("simulator: an output folder is required");
+  const Simulation simulation = BuildSimulation(options);
+  WriteSimulation(simulation, options, progress);
+  SimulationSummary summary = Summarize(simulation, options);
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+std::string FormatSummary(const SimulationSummary& summary, const std::string& output_dir) {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(1);
+  os << "simulated a " << (summary.hybrid ? "hybrid" : "synthetic") << " sequence: " << summary.frames
+     << " stereo frames, " << summary.imu_samples << " IMU samples, " << summary.landmarks << " landmarks; ";
+  if (summary.camera_output == SimCameraOutput::kFeatures) {
+    os << summary.features_per_frame << " features per frame (" << summary.stereo_features_per_frame
+       << " seen in both cameras), median track length " << summary.median_track_length << " frames; ";
+  } else {
+    os << 2 * summary.frames << " images rendered; ";
+  }
+  os << "took " << summary.seconds << " s; wrote " << output_dir << "\n";
+  return os.str();
+}
+
+}  // namespace vio::tools
