@@ -22,6 +22,7 @@ void Estimator::SetInitialState(const InitialState& state) { given_initial_state
 
 FrameEstimate Estimator::ProcessFrame(const StereoFrame& frame) {
   const auto start = std::chrono::steady_clock::now();
+  window_.ClearRemovals();
   FrameTiming timing;
   if (!last_state_.valid()) {
     if (!Initialize(frame)) {

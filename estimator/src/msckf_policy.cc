@@ -24,8 +24,9 @@ bool IsLeaving(StateId state, const std::vector<StateId>& leaving) {
 
 }  // namespace
 
-MsckfPolicy::MsckfPolicy(const EstimatorOptions& options, int gn_steps) : options_(options), gn_steps_(gn_steps) {
-  CHECK_GE(gn_steps_, 1);
+MsckfPolicy::MsckfPolicy(const EstimatorOptions& options, std::optional<int> gn_steps)
+    : options_(options), gn_steps_(gn_steps) {
+  CHECK(!gn_steps_ || *gn_steps_ >= 1);
   CHECK_GE(options_.policy.window_size, 2) << "the MSCKF needs a window of at least 2 states";
 }
 
@@ -39,9 +40,8 @@ PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
   timing.build_ms = MillisecondsSince(start);
 
   start = std::chrono::steady_clock::now();
-  SolverOptions solver = options_.solver;
-  solver.max_iterations = gn_steps_;
-  const SolveReport report = window.Solve(solver);
+  const SolveReport report =
+      gn_steps_ ? window.TakeSteps(*gn_steps_, options_.solver) : window.Solve(options_.solver);
   timing.solver_iterations = report.iterations;
   timing.solve_ms = MillisecondsSince(start);
   VLOG(1) << "msckf t=" << frame.t_ns << ": " << added.size() << " landmarks, " << leaving.size()

@@ -5,6 +5,7 @@
 #include "vio/estimator/pose_manifold.h"
 #include "vio/estimator/stereo_geometry.h"
 #include "vio/estimator/batch_policy.h"
+#include "vio/estimator/ekf_policy.h"
 #include "vio/estimator/keyframe_policy.h"
 #include "vio/estimator/msckf_policy.h"
 #include "vio/estimator/swf_policy.h"
@@ -17,16 +18,8 @@ std::unique_ptr<Policy> MakePolicy(const EstimatorOptions& options) {
   if (name == "keyframe") return std::make_unique<KeyframePolicy>(options);
   if (name == "batch") return std::make_unique<BatchPolicy>(options);
   if (name == "msckf") return std::make_unique<MsckfPolicy>(options, options.msckf.msckf_gn_steps);
-  if (name == "fixed_lag") return std::make_unique<MsckfPolicy>(options, options.solver.max_iterations);
-  if (name == "ekf" || name == "iekf") {
-    // EKF-SLAM is SWF(1) keeping the landmarks (paper §4.3): one Gauss-Newton
-    // step per frame, or several for the iterated EKF.
-    EstimatorOptions ekf = options;
-    ekf.policy.window_size = 1;
-    ekf.policy.swf_landmarks = "keep";
-    if (name == "ekf") ekf.solver.max_iterations = 1;
-    return std::make_unique<SwfPolicy>(ekf);
-  }
+  if (name == "fixed_lag") return std::make_unique<MsckfPolicy>(options, std::nullopt);
+  if (name == "ekf" || name == "iekf") return std::make_unique<EkfPolicy>(options, name == "iekf");
   throw std::invalid_argument("unknown policy '" + name + "'");
 }
 

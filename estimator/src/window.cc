@@ -1,6 +1,7 @@
 #include "vio/estimator/window.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include <glog/logging.h>
@@ -123,14 +124,36 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
   it->second.observed_from.insert(state_id);
 }
 
-// Landmarks (group 0) are eliminated first by the Schur complement; the
-// state blocks follow, one group each in id order, so that the reduced system
-// is laid out by the window's ids rather than by addresses (Ceres orders the
-// blocks inside one group by address). Landmarks tied together by a prior are
-// not an independent set: they join the states, after them.
-std::shared_ptr<ceres::ParameterBlockOrdering> Window::SchurOrdering() const {
+std::set<const double*> Window::BlocksInPriors() const {
   std::set<const double*> in_prior;
   for (const Prior& prior : priors_) in_prior.insert(prior.blocks.begin(), prior.blocks.end());
+  return in_prior;
+}
+
+GaussNewtonLayout Window::Layout() const {
+  const std::set<const double*> in_prior = BlocksInPriors();
+  GaussNewtonLayout layout;
+  const auto variable = [this](const double* block) { return !problem_->IsParameterBlockConstant(block); };
+  for (const auto& [id, s] : states_) {
+    for (const double* block : {s.pose, s.speed_bias}) {
+      if (variable(block)) layout.dense.push_back(const_cast<double*>(block));
+    }
+  }
+  for (const auto& [id, landmark] : landmarks_) {
+    if (!variable(landmark.p_w)) continue;
+    auto& group = in_prior.count(landmark.p_w) ? layout.dense : layout.eliminated;
+    group.push_back(const_cast<double*>(landmark.p_w));
+  }
+  return layout;
+}
+
+// Landmarks (group 0) are eliminated first by the Schur complement; the
+// state blocks follow, one group each in id order. Ceres orders the blocks
+// inside one group by address, so LM runs depend on the heap layout in the
+// last digits (gn does not: Layout() is by id). Landmarks tied together by a
+// prior are not an independent set: they join the states, after them.
+std::shared_ptr<ceres::ParameterBlockOrdering> Window::SchurOrdering() const {
+  const std::set<const double*> in_prior = BlocksInPriors();
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   int group = 1;
   for (const auto& [id, s] : states_) {
@@ -182,11 +205,56 @@ void Window::ChooseLinearSolver(const std::string& linear_solver, ceres::Solver:
 }
 
 SolveReport Window::Solve(const SolverOptions& options) {
+  if (options.step == "gn") return GaussNewton(options.max_iterations, /*until_converged=*/true, options);
   ceres::Solver::Options solver;
-  ChooseLinearSolver(options.linear_solver, &solver);
   solver.max_num_iterations = options.max_iterations;
-  solver.max_solver_time_in_seconds = options.max_solver_time_s;
   solver.function_tolerance = options.function_tolerance;
+  return LevenbergMarquardt(solver, options);
+}
+
+SolveReport Window::TakeSteps(int steps, const SolverOptions& options) {
+  CHECK_GE(steps, 1);
+  if (options.step == "gn") return GaussNewton(steps, /*until_converged=*/false, options);
+  ceres::Solver::Options solver;
+  solver.max_num_iterations = steps;
+  solver.function_tolerance = 0;
+  solver.gradient_tolerance = 0;
+  solver.parameter_tolerance = 0;
+  return LevenbergMarquardt(solver, options);
+}
+
+SolveReport Window::GaussNewton(int max_steps, bool until_converged, const SolverOptions& options) {
+  SolveReport report;
+  const GaussNewtonLayout layout = Layout();
+  for (int k = 0; k < max_steps; ++k) {
+    const GaussNewtonStep step = TakeGaussNewtonStep(problem_.get(), layout);
+    if (k == 0) report.initial_cost = report.final_cost = step.cost;
+    if (!step.ok) {
+      report.usable = false;
+      break;
+    }
+    ++report.iterations;
+    double cost = 0;
+    if (!EvaluateCost(problem_.get(), &cost)) {
+      report.usable = false;
+      break;
+    }
+    report.final_cost = cost;
+    const bool small_change = std::abs(step.cost - cost) <= options.function_tolerance * step.cost;
+    const bool small_step =
+        step.step_norm <= options.parameter_tolerance * (step.values_norm + options.parameter_tolerance);
+    if (until_converged && (small_change || small_step)) {
+      report.converged = true;
+      break;
+    }
+  }
+  return report;
+}
+
+SolveReport Window::LevenbergMarquardt(const ceres::Solver::Options& base, const SolverOptions& options) {
+  ceres::Solver::Options solver = base;
+  ChooseLinearSolver(options.linear_solver, &solver);
+  solver.max_solver_time_in_seconds = options.max_solver_time_s;
   solver.num_threads = options.num_threads;
   solver.minimizer_progress_to_stdout = false;
   solver.logging_type = ceres::SILENT;
@@ -197,6 +265,7 @@ SolveReport Window::Solve(const SolverOptions& options) {
   report.initial_cost = summary.initial_cost;
   report.final_cost = summary.final_cost;
   report.usable = summary.IsSolutionUsable();
+  report.converged = summary.termination_type == ceres::CONVERGENCE;
   return report;
 }
 
@@ -262,6 +331,9 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   }
   for (StateId id : state_ids) RemoveStateBookkeeping(id);
   for (LandmarkId id : landmark_ids) landmarks_.erase(id);
+  removals_.marginalized_states.insert(removals_.marginalized_states.end(), state_ids.begin(), state_ids.end());
+  removals_.marginalized_landmarks.insert(removals_.marginalized_landmarks.end(), landmark_ids.begin(),
+                                          landmark_ids.end());
 }
 
 // Drops the bookkeeping of every residual that touches a removed block; the
@@ -306,6 +378,7 @@ void Window::DropLandmark(LandmarkId landmark_id) {
   ForgetResidualsOf(removed);
   problem_->RemoveParameterBlock(it->second.p_w);
   landmarks_.erase(landmark_id);
+  removals_.dropped_landmarks.push_back(landmark_id);
 }
 
 bool Window::IsInPrior(StateId id) const {
@@ -340,6 +413,7 @@ void Window::DropState(StateId id) {
   problem_->RemoveParameterBlock(s.pose);
   problem_->RemoveParameterBlock(s.speed_bias);
   states_.erase(id);
+  removals_.dropped_states.push_back(id);
   ImuEdge& edge = imu_edges_.emplace(merged.to, std::move(merged)).first->second;
   AddImuResidual(edge);
 }

@@ -1,6 +1,6 @@
 // `vio run` end to end on a short synthetic dataset the simulator makes:
-// the SWF tracks the ground truth, and the same command twice writes
-// byte-identical trajectories.
+// the SWF tracks the ground truth, and the same command twice, or with
+// another output folder and environment, writes byte-identical trajectories.
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -100,6 +100,26 @@ TEST(RunSynthetic, SameCommandTwiceGivesByteIdenticalTrajectories) {
   const std::string trajectory = ReadFile(a + "/trajectory.txt");
   EXPECT_GT(trajectory.size(), 1000u);
   EXPECT_EQ(trajectory, ReadFile(b + "/trajectory.txt"));
+}
+
+// Results depend only on inputs and flags: two runs that differ in the output
+// folder's name and in the size of the environment (both move the heap
+// layout) write byte-identical trajectories, for the SWF and the MSCKF.
+TEST(RunSynthetic, OutputFolderAndEnvironmentDoNotChangeTheTrajectory) {
+  for (const std::string policy : {"swf", "msckf"}) {
+    const std::string base = test::MakeTempDir("run_layout_" + policy);
+    const std::string a = base + "/a";
+    const std::string b = base + "/some/much/longer/name";
+    const std::string run = std::string(VIO_BINARY) + " run --dataset=" + SyntheticDataset() + " --policy=" + policy;
+    const std::string padding = "VIO_TEST_PADDING=" + std::string(3000, 'x');
+    ASSERT_EQ(std::system((run + " --output_dir=" + a + " > " + base + "/a.log 2>&1").c_str()), 0) << policy;
+    ASSERT_EQ(std::system(("env " + padding + " " + run + " --output_dir=" + b + " > " + base + "/b.log 2>&1").c_str()),
+              0)
+        << policy;
+    const std::string trajectory = ReadFile(a + "/trajectory.txt");
+    EXPECT_GT(trajectory.size(), 1000u) << policy;
+    EXPECT_EQ(trajectory, ReadFile(b + "/trajectory.txt")) << policy;
+  }
 }
 
 TEST(RunSynthetic, DatasetWithoutFeaturesIsAClearError) {

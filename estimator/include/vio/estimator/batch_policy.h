@@ -14,7 +14,9 @@ namespace vio {
 
 class BatchPolicy final : public Policy {
  public:
-  explicit BatchPolicy(const EstimatorOptions& options) : options_(options) {}
+  /// Always Ceres' Levenberg-Marquardt (step=lm): the whole sequence is one
+  /// sparse problem, beyond the window's dense Gauss-Newton.
+  explicit BatchPolicy(const EstimatorOptions& options) : options_(options) { options_.solver.step = "lm"; }
   PolicyTiming Update(const StereoFrame& frame, StateId new_state, Window& window) override;
   bool Finish(Window& window) override;
 

@@ -14,21 +14,27 @@ struct PolicyOptions {
   int window_size = 10;         ///< states kept in the window [frames]
   /// What happens to landmarks seen by the state that leaves an SWF window.
   std::string swf_landmarks = "marginalize";
+  /// What EKF-SLAM does with landmarks the newest frame did not observe.
+  std::string ekf_landmarks = "keep";
   int keyframe_temporal_window = 3;  ///< keyframe policy: most recent frames always kept [frames]
   double keyframe_overlap = 0.7;     ///< keyframe policy: new keyframe below this shared-landmark fraction []
 
   template <class V>
   void Visit(V& v) {
     v("policy", policy,
-      "estimator policy: swf (sliding window), msckf (MSCKF as optimization), ekf (EKF-SLAM: window 1, one GN "
-      "step), iekf (iterated EKF), fixed_lag (MSCKF marginalization, GN to convergence), keyframe (OKVIS-like), "
-      "batch (no marginalization)",
+      "estimator policy: swf (sliding window), msckf (MSCKF as optimization), ekf (EKF-SLAM: previous state "
+      "marginalized before one GN step), iekf (iterated EKF: GN to convergence), fixed_lag (MSCKF "
+      "marginalization, GN to convergence), keyframe (OKVIS-like), batch (no marginalization)",
       {"swf", "msckf", "ekf", "iekf", "fixed_lag", "keyframe", "batch"});
     v("window_size", window_size, "states kept in the sliding window [frames]");
     v("swf_landmarks", swf_landmarks,
       "SWF: landmarks seen by the leaving state are kept (paper-exact, prior over them) "
       "or marginalized with it (prior over states only, faster)",
       {"keep", "marginalize"});
+    v("ekf_landmarks", ekf_landmarks,
+      "ekf, iekf: every landmark stays in the state (keep, the paper's EKF-SLAM; cost grows with the map) or "
+      "those the newest frame did not observe are marginalized after the update (marginalize_unseen, bounded)",
+      {"keep", "marginalize_unseen"});
     v("keyframe_temporal_window", keyframe_temporal_window,
       "keyframe policy: the most recent frames, always kept [frames]");
     v("keyframe_overlap", keyframe_overlap,
@@ -79,9 +85,13 @@ struct BatchOptions {
   }
 };
 
-/// Gauss-Newton through Ceres.
+/// Gauss-Newton steps on the window (Ceres evaluates and, for lm, solves).
 struct SolverOptions {
-  int max_iterations = 3;         ///< Gauss-Newton iterations per frame [count]
+  /// gn: undamped Gauss-Newton, every step taken (the paper's step);
+  /// lm: Ceres' Levenberg-Marquardt (trust region, steps may be rejected).
+  std::string step = "gn";
+  int max_iterations = 10;        ///< most steps of a to-convergence solve (a safety net) [count]
+  double parameter_tolerance = 1e-8;  ///< gn: converged when |dx| <= this * (|x| + this) []
   double max_solver_time_s = 1.0;   ///< wall-time bound per solve [s] (a run that hits it is not reproducible)
   double function_tolerance = 1e-6;  ///< relative cost decrease that counts as converged []
   int num_threads = 1;            ///< Ceres threads [count]
@@ -89,7 +99,15 @@ struct SolverOptions {
 
   template <class V>
   void Visit(V& v) {
-    v("max_iterations", max_iterations, "Gauss-Newton iterations per frame [count]");
+    v("step", step,
+      "gn: undamped Gauss-Newton steps, each taken (the paper's); lm: Ceres Levenberg-Marquardt (damped, may "
+      "reject steps)",
+      {"gn", "lm"});
+    v("max_iterations", max_iterations,
+      "most Gauss-Newton steps of a solve to convergence, a safety net (the criterion is function_tolerance / "
+      "parameter_tolerance) [count]");
+    v("parameter_tolerance", parameter_tolerance,
+      "gn: converged when the step |dx| <= this * (|x| + this) []");
     v("linear_solver", linear_solver,
       "dense or sparse Cholesky of the Schur-reduced system (sparse: large windows), sparse_full (sparse Cholesky "
       "of the whole system, states eliminated before landmarks: whole sequences, batch's final solve) or iterative "

@@ -33,8 +33,9 @@ struct MsckfCounts {
 
 class MsckfPolicy final : public Policy {
  public:
-  /// `gn_steps`: Gauss-Newton steps per update (1 = MSCKF).
-  MsckfPolicy(const EstimatorOptions& options, int gn_steps);
+  /// `gn_steps`: Gauss-Newton steps per update (1 = MSCKF); none: to
+  /// convergence (fixed_lag).
+  MsckfPolicy(const EstimatorOptions& options, std::optional<int> gn_steps);
   PolicyTiming Update(const StereoFrame& frame, StateId new_state, Window& window) override;
   const MsckfCounts& counts() const { return counts_; }
 
@@ -54,7 +55,7 @@ class MsckfPolicy final : public Policy {
   void ForgetObservationsOf(const std::vector<StateId>& leaving);
 
   EstimatorOptions options_;
-  int gn_steps_;
+  std::optional<int> gn_steps_;
   std::map<LandmarkId, std::vector<Observation>> tracks_;  ///< unused observations, oldest first
   MsckfCounts counts_;
 };

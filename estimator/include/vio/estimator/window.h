@@ -17,6 +17,7 @@
 #include <ceres/ceres.h>
 
 #include "vio/estimator/estimator_options.h"
+#include "vio/estimator/gauss_newton.h"
 #include "vio/estimator/imu_preintegration.h"
 #include "vio/estimator/types.h"
 
@@ -53,12 +54,21 @@ struct StatePrior {
   Eigen::Matrix<double, 9, 1> speed_bias_sigma;   ///< [v (m/s), b_g (rad/s), b_a (m/s^2)]
 };
 
-/// What one Solve did.
+/// What one Solve or TakeSteps did.
 struct SolveReport {
   int iterations = 0;
   double initial_cost = 0;
   double final_cost = 0;
   bool usable = true;
+  bool converged = false;  ///< gn, Solve: stopped by the convergence criterion, not the cap
+};
+
+/// What Marginalize and the Drop* calls removed, in call order.
+struct Removals {
+  std::vector<StateId> marginalized_states;
+  std::vector<LandmarkId> marginalized_landmarks;
+  std::vector<StateId> dropped_states;
+  std::vector<LandmarkId> dropped_landmarks;  ///< incl. those a dropped state left unobserved
 };
 
 class Window {
@@ -79,7 +89,14 @@ class Window {
   void AddObservation(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px);
 
   // ---- Gauss-Newton ---------------------------------------------------------
+  /// Steps to convergence. step=gn: undamped Gauss-Newton steps until the
+  /// relative cost change is <= function_tolerance or |dx| <= parameter_tolerance
+  /// * (|x| + parameter_tolerance), at most max_iterations; step=lm: Ceres'
+  /// Levenberg-Marquardt with the same bounds.
   SolveReport Solve(const SolverOptions& options);
+  /// Exactly `steps` steps (a filter's update: one Gauss-Newton step); with
+  /// step=lm, `steps` Levenberg-Marquardt iterations (rejected ones count).
+  SolveReport TakeSteps(int steps, const SolverOptions& options);
   /// Re-preintegrates IMU factors whose gyro-bias linearization moved too far.
   int RefreshImuFactors(double gyro_bias_threshold);
 
@@ -101,6 +118,10 @@ class Window {
   void DropState(StateId id);
   /// True when a marginalization prior involves the state.
   bool IsInPrior(StateId id) const;
+  /// What was removed since the last ClearRemovals (the estimator clears it
+  /// every frame; the structural policy tests read it).
+  const Removals& removals() const { return removals_; }
+  void ClearRemovals() { removals_ = Removals(); }
 
   // ---- queries ---------------------------------------------------------------
   const std::map<StateId, State>& states() const { return states_; }
@@ -134,6 +155,12 @@ class Window {
   using ObservationKey = std::pair<StateId, LandmarkId>;
 
   void AddImuResidual(ImuEdge& edge);
+  SolveReport GaussNewton(int max_steps, bool until_converged, const SolverOptions& options);
+  SolveReport LevenbergMarquardt(const ceres::Solver::Options& base, const SolverOptions& options);
+  /// Variable blocks in id order: states, then landmarks tied by a prior
+  /// (dense); the other landmarks are eliminated.
+  GaussNewtonLayout Layout() const;
+  std::set<const double*> BlocksInPriors() const;
   std::shared_ptr<ceres::ParameterBlockOrdering> SchurOrdering() const;
   std::shared_ptr<ceres::ParameterBlockOrdering> StatesFirstOrdering() const;
   void ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const;
@@ -150,6 +177,7 @@ class Window {
   std::map<StateId, ImuEdge> imu_edges_;  ///< keyed by the later state (`to`)
   std::map<ObservationKey, Observation> observations_;
   std::vector<Prior> priors_;
+  Removals removals_;
 };
 
 }  // namespace vio

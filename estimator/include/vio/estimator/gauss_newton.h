@@ -1,0 +1,41 @@
+#pragma once
+// One exact Gauss-Newton step on a ceres::Problem (paper §2.2): linearize every
+// residual at the current values (Problem::Evaluate: loss functions applied as
+// Ceres applies them, Jacobians on the tangent spaces), solve the normal
+// equations J^T J dx = -J^T r without damping, and apply x <- x ⊞ dx. The step
+// is always taken: no trust region, no line search, no rejected steps.
+//
+// The columns are laid out by the caller (the window: states and landmarks by
+// id), never by address, so the result does not depend on the heap layout.
+// Mutually uncoupled blocks (landmarks, which no residual ties to another
+// landmark) are eliminated first, one block at a time (Schur complement); the
+// reduced system over the rest is solved densely (Cholesky).
+#include <vector>
+
+#include <ceres/problem.h>
+
+namespace vio {
+
+/// Which variable parameter blocks the step solves for, in column order.
+struct GaussNewtonLayout {
+  std::vector<double*> dense;       ///< solved densely (states, landmarks tied by a prior)
+  std::vector<double*> eliminated;  ///< no residual touches two of them: Schur-eliminated one by one
+};
+
+/// What one step did.
+struct GaussNewtonStep {
+  bool ok = false;         ///< false: evaluation failed or the system is singular; nothing was changed
+  double cost = 0;         ///< cost at the linearization point, 1/2 |r|^2 (loss applied)
+  double step_norm = 0;    ///< |dx| on the tangent space
+  double values_norm = 0;  ///< |x| of the blocks before the step (ambient values)
+};
+
+/// Takes one undamped Gauss-Newton step on the blocks of `layout`; every
+/// other block is held at its value. Residual order is the problem's.
+GaussNewtonStep TakeGaussNewtonStep(ceres::Problem* problem, const GaussNewtonLayout& layout);
+
+/// 1/2 |r|^2 of the whole problem at its current values, loss applied; false
+/// when evaluation fails.
+bool EvaluateCost(ceres::Problem* problem, double* cost);
+
+}  // namespace vio
