@@ -206,10 +206,12 @@ double SquaredNorm(const ceres::Problem& problem, const std::vector<double*>& bl
 GaussNewtonStep TakeGaussNewtonStep(ceres::Problem* problem, const GaussNewtonLayout& layout) {
   GaussNewtonStep step;
   ceres::Problem::EvaluateOptions evaluate;
+  evaluate.residual_blocks = layout.residuals;
   evaluate.parameter_blocks = layout.dense;
   evaluate.parameter_blocks.insert(evaluate.parameter_blocks.end(), layout.eliminated.begin(),
                                    layout.eliminated.end());
-  if (evaluate.parameter_blocks.empty()) return step;  // an empty list would mean every block
+  // An empty list would mean every block.
+  if (evaluate.parameter_blocks.empty() || evaluate.residual_blocks.empty()) return step;
   std::vector<double> r;
   ceres::CRSMatrix J;
   if (!problem->Evaluate(evaluate, &step.cost, &r, nullptr, &J)) return step;
@@ -248,8 +250,11 @@ GaussNewtonStep TakeGaussNewtonStep(ceres::Problem* problem, const GaussNewtonLa
   return step;
 }
 
-bool EvaluateCost(ceres::Problem* problem, double* cost) {
-  return problem->Evaluate(ceres::Problem::EvaluateOptions(), cost, nullptr, nullptr, nullptr);
+bool EvaluateCost(ceres::Problem* problem, const GaussNewtonLayout& layout, double* cost) {
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.residual_blocks = layout.residuals;
+  *cost = 0;
+  return layout.residuals.empty() || problem->Evaluate(evaluate, cost, nullptr, nullptr, nullptr);
 }
 
 }  // namespace vio

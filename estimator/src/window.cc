@@ -130,9 +130,20 @@ std::set<const double*> Window::BlocksInPriors() const {
   return in_prior;
 }
 
+std::vector<ceres::ResidualBlockId> Window::ResidualOrder() const {
+  std::vector<ceres::ResidualBlockId> order;
+  order.reserve(static_cast<size_t>(problem_->NumResidualBlocks()));
+  for (const Prior& prior : priors_) order.push_back(prior.residual);
+  for (const auto& [to, edge] : imu_edges_) order.push_back(edge.residual);
+  for (const auto& [key, observation] : observations_) order.push_back(observation.residual);
+  CHECK_EQ(static_cast<int>(order.size()), problem_->NumResidualBlocks()) << "a residual block the window does not know";
+  return order;
+}
+
 GaussNewtonLayout Window::Layout() const {
   const std::set<const double*> in_prior = BlocksInPriors();
   GaussNewtonLayout layout;
+  layout.residuals = ResidualOrder();
   const auto variable = [this](const double* block) { return !problem_->IsParameterBlockConstant(block); };
   for (const auto& [id, s] : states_) {
     for (const double* block : {s.pose, s.speed_bias}) {
@@ -235,11 +246,12 @@ SolveReport Window::GaussNewton(int max_steps, bool until_converged, const Solve
     }
     ++report.iterations;
     double cost = 0;
-    if (!EvaluateCost(problem_.get(), &cost)) {
+    if (!EvaluateCost(problem_.get(), layout, &cost)) {
       report.usable = false;
       break;
     }
     report.final_cost = cost;
+    VLOG(2) << "gn step " << k << ": cost " << step.cost << " -> " << cost << ", |dx| " << step.step_norm;
     const bool small_change = std::abs(step.cost - cost) <= options.function_tolerance * step.cost;
     const bool small_step =
         step.step_norm <= options.parameter_tolerance * (step.values_norm + options.parameter_tolerance);
@@ -321,9 +333,11 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
     blocks.push_back(it->second.p_w);
   }
   if (blocks.empty()) return;
+  marginalization::MarginalizationOptions options;
+  options.residual_order = ResidualOrder();
   std::set<const double*> removed(blocks.begin(), blocks.end());
   ForgetResidualsOf(removed);
-  ceres::ResidualBlockId prior = marginalization::MarginalizeBlocks(problem_.get(), blocks);
+  ceres::ResidualBlockId prior = marginalization::MarginalizeBlocks(problem_.get(), blocks, options);
   if (prior != nullptr) {
     std::vector<double*> kept;
     problem_->GetParameterBlocksForResidualBlock(prior, &kept);

@@ -52,19 +52,21 @@ std::vector<double*> UniqueBlocksInProblem(const ceres::Problem& problem,
 }
 
 std::vector<ceres::ResidualBlockId> ResidualBlocksTouching(const ceres::Problem& problem,
-                                                           const std::vector<double*>& marg) {
+                                                           const std::vector<double*>& marg,
+                                                           const std::vector<ceres::ResidualBlockId>& order) {
   std::unordered_set<ceres::ResidualBlockId> touching;
   std::vector<ceres::ResidualBlockId> of_block;
   for (const double* block : marg) {
     problem.GetResidualBlocksForParameterBlock(block, &of_block);
     touching.insert(of_block.begin(), of_block.end());
   }
-  // Problem order, so that summation order (and the result) is reproducible.
-  std::vector<ceres::ResidualBlockId> all;
-  problem.GetResidualBlocks(&all);
+  // A fixed order, so that summation order (and the result) is reproducible.
+  std::vector<ceres::ResidualBlockId> all = order;
+  if (all.empty()) problem.GetResidualBlocks(&all);
   std::vector<ceres::ResidualBlockId> ordered;
   std::copy_if(all.begin(), all.end(), std::back_inserter(ordered),
                [&touching](ceres::ResidualBlockId id) { return touching.count(id) > 0; });
+  CHECK_EQ(ordered.size(), touching.size()) << "residual_order misses residual blocks of the marginalized blocks";
   return ordered;
 }
 
@@ -94,9 +96,10 @@ void SplitMarginalized(const ceres::Problem& problem, const std::vector<double*>
   }
 }
 
-MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector<double*>& marg) {
+MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector<double*>& marg,
+                                const std::vector<ceres::ResidualBlockId>& order) {
   MarkovBlanket blanket;
-  blanket.residual_blocks = ResidualBlocksTouching(problem, marg);
+  blanket.residual_blocks = ResidualBlocksTouching(problem, marg, order);
   const BlockSet marg_set(marg.begin(), marg.end());
   BlockSet kept_seen;
   std::unordered_map<const double*, BlockSet> coupled;
@@ -233,7 +236,7 @@ MarginalizationResult ComputeMarginalization(ceres::Problem* problem,
                                              const MarginalizationOptions& options) {
   CHECK(problem != nullptr);
   const std::vector<double*> marg = UniqueBlocksInProblem(*problem, to_marginalize);
-  MarkovBlanket blanket = FindMarkovBlanket(*problem, marg);
+  MarkovBlanket blanket = FindMarkovBlanket(*problem, marg, options.residual_order);
   MarginalizationResult result;
   result.marginalized_residual_blocks = blanket.residual_blocks;
   if (!blanket.kept.empty()) {

@@ -20,6 +20,9 @@ namespace vio {
 struct GaussNewtonLayout {
   std::vector<double*> dense;       ///< solved densely (states, landmarks tied by a prior)
   std::vector<double*> eliminated;  ///< no residual touches two of them: Schur-eliminated one by one
+  /// Every residual block of the problem, in summation order (Ceres' own
+  /// order changes with addresses once blocks were removed).
+  std::vector<ceres::ResidualBlockId> residuals;
 };
 
 /// What one step did.
@@ -31,11 +34,11 @@ struct GaussNewtonStep {
 };
 
 /// Takes one undamped Gauss-Newton step on the blocks of `layout`; every
-/// other block is held at its value. Residual order is the problem's.
+/// other block is held at its value.
 GaussNewtonStep TakeGaussNewtonStep(ceres::Problem* problem, const GaussNewtonLayout& layout);
 
-/// 1/2 |r|^2 of the whole problem at its current values, loss applied; false
-/// when evaluation fails.
-bool EvaluateCost(ceres::Problem* problem, double* cost);
+/// 1/2 |r|^2 of the layout's residuals at the current values, loss applied;
+/// false when evaluation fails.
+bool EvaluateCost(ceres::Problem* problem, const GaussNewtonLayout& layout, double* cost);
 
 }  // namespace vio

@@ -161,6 +161,9 @@ class Window {
   /// (dense); the other landmarks are eliminated.
   GaussNewtonLayout Layout() const;
   std::set<const double*> BlocksInPriors() const;
+  /// Every residual block: priors in creation order, IMU factors and
+  /// observations by ids (never by address).
+  std::vector<ceres::ResidualBlockId> ResidualOrder() const;
   std::shared_ptr<ceres::ParameterBlockOrdering> SchurOrdering() const;
   std::shared_ptr<ceres::ParameterBlockOrdering> StatesFirstOrdering() const;
   void ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const;

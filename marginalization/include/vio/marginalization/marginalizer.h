@@ -37,6 +37,10 @@ struct MarginalizationOptions {
   /// sliding window easily has 300-700 dimensions, where kEigen costs
   /// 0.1-0.7 s and kPivotedLdlt 15-20x less.
   SqrtMethod sqrt_method = SqrtMethod::kPivotedLdlt;
+  /// The order in which residual blocks are summed, when not empty (it must
+  /// hold every residual block touching a marginalized block). Empty: the
+  /// problem's order, which Ceres' block removal makes depend on addresses.
+  std::vector<ceres::ResidualBlockId> residual_order;
 };
 
 struct MarginalizationResult {
