@@ -52,21 +52,27 @@ class SyntheticFlight {
   /// factors, a prior on the first, every observation added.
   void Build(Window& window, const ModelOptions& model, int first, int count, double position_offset_m = 0) const {
     for (int k = 0; k < count; ++k) {
-      const StereoFrame& frame = frames_[first + k];
-      const tools::GroundTruthState& gt = GroundTruthAt(frame.t_ns);
-      State& s = window.AddState(StateId(k), frame.t_ns);
-      s.SetPose(gt.p_w_b + Eigen::Vector3d::Constant(k % 2 ? position_offset_m : -position_offset_m), gt.q_w_b);
-      s.SetSpeedBias(gt.v_w_b, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-      if (k == 0) {
-        StatePrior prior;
-        prior.pose_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e-6;
-        prior.speed_bias_sigma << Eigen::Vector3d::Constant(0.1), Eigen::Vector3d::Constant(0.01),
-            Eigen::Vector3d::Constant(0.1);
-        window.AddStatePrior(StateId(k), prior);
-      } else {
-        window.AddImuFactor(StateId(k - 1), StateId(k), ImuBetween(first + k - 1));
-      }
-      AddStereoObservations(frame, StateId(k), model, window);
+      AddState(window, first, k, Eigen::Vector3d::Constant(k % 2 ? position_offset_m : -position_offset_m));
+      AddStereoObservations(frames_[first + k], StateId(k), model, window);
+    }
+  }
+
+  /// State k at frame first + k, at the ground truth moved by `offset_m`:
+  /// the prior when k == 0, else the IMU factor from state k - 1.
+  void AddState(Window& window, int first, int k, const Eigen::Vector3d& offset_m) const {
+    const StereoFrame& frame = frames_[first + k];
+    const tools::GroundTruthState& gt = GroundTruthAt(frame.t_ns);
+    State& s = window.AddState(StateId(k), frame.t_ns);
+    s.SetPose(gt.p_w_b + offset_m, gt.q_w_b);
+    s.SetSpeedBias(gt.v_w_b, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+    if (k == 0) {
+      StatePrior prior;
+      prior.pose_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e-6;
+      prior.speed_bias_sigma << Eigen::Vector3d::Constant(0.1), Eigen::Vector3d::Constant(0.01),
+          Eigen::Vector3d::Constant(0.1);
+      window.AddStatePrior(StateId(k), prior);
+    } else {
+      window.AddImuFactor(StateId(k - 1), StateId(k), ImuBetween(first + k - 1));
     }
   }
 

@@ -101,19 +101,7 @@ std::vector<FrameRecord> RunScript(const EstimatorOptions& options) {
   std::vector<FrameRecord> records;
   for (int k = 0; k < kFrames; ++k) {
     const StereoFrame frame = ScriptedFrame(k);
-    const tools::GroundTruthState& gt = Flight().GroundTruthAt(frame.t_ns);
-    State& s = window.AddState(StateId(k), frame.t_ns);
-    s.SetPose(gt.p_w_b + Eigen::Vector3d(0.05, 0, 0), gt.q_w_b);
-    s.SetSpeedBias(gt.v_w_b, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-    if (k == 0) {
-      StatePrior prior;
-      prior.pose_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e-6;
-      prior.speed_bias_sigma << Eigen::Vector3d::Constant(0.1), Eigen::Vector3d::Constant(0.01),
-          Eigen::Vector3d::Constant(0.1);
-      window.AddStatePrior(StateId(k), prior);
-    } else {
-      window.AddImuFactor(StateId(k - 1), StateId(k), Flight().ImuBetween(kFirst + k - 1));
-    }
+    Flight().AddState(window, kFirst, k, Eigen::Vector3d(0.05, 0, 0));
     window.ClearRemovals();
     const PolicyTiming timing = policy->Update(frame, StateId(k), window);
     FrameRecord record;

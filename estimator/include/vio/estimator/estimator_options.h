@@ -93,7 +93,7 @@ struct SolverOptions {
   int max_iterations = 10;        ///< most steps of a to-convergence solve (a safety net) [count]
   double parameter_tolerance = 1e-8;  ///< gn: converged when |dx| <= this * (|x| + this) []
   double max_solver_time_s = 1.0;   ///< wall-time bound per solve [s] (a run that hits it is not reproducible)
-  double function_tolerance = 1e-6;  ///< relative cost decrease that counts as converged []
+  double function_tolerance = 1e-4;  ///< relative cost change that counts as converged []
   int num_threads = 1;            ///< Ceres threads [count]
   std::string linear_solver = "dense";  ///< dense | sparse (Schur-reduced) | sparse_full (whole system) | iterative
 
@@ -115,7 +115,7 @@ struct SolverOptions {
       {"dense", "sparse", "sparse_full", "iterative"});
     v("max_solver_time_s", max_solver_time_s,
       "wall-time bound of one solve [s]; a safety net: a run that hits it is not reproducible");
-    v("function_tolerance", function_tolerance, "relative cost decrease that counts as converged []");
+    v("function_tolerance", function_tolerance, "relative cost change that counts as converged []");
     v("num_threads", num_threads, "Ceres threads [count]");
   }
 };
