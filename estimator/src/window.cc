@@ -1,6 +1,7 @@
 #include "vio/estimator/window.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include <glog/logging.h>
@@ -15,6 +16,26 @@
 namespace vio {
 namespace {
 constexpr double kNoAccelThreshold = std::numeric_limits<double>::infinity();
+
+// True when the residual and its Jacobians evaluate to finite values at the
+// current point.
+bool EvaluatesFinitely(const ceres::Problem& problem, ceres::ResidualBlockId id) {
+  const ceres::CostFunction* f = problem.GetCostFunctionForResidualBlock(id);
+  std::vector<double> residuals(static_cast<size_t>(f->num_residuals()));
+  std::vector<std::vector<double>> jacobian_storage;
+  std::vector<double*> jacobians;
+  for (const int size : f->parameter_block_sizes()) {
+    jacobian_storage.emplace_back(static_cast<size_t>(size * f->num_residuals()));
+    jacobians.push_back(jacobian_storage.back().data());
+  }
+  double cost = 0.0;
+  if (!problem.EvaluateResidualBlock(id, true, &cost, residuals.data(), jacobians.data())) return false;
+  const auto finite = [](const std::vector<double>& v) {
+    return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+  };
+  return std::isfinite(cost) && finite(residuals) && std::all_of(jacobian_storage.begin(), jacobian_storage.end(), finite);
+}
+
 }  // namespace
 
 void State::SetPose(const Eigen::Vector3d& p_w_b, const Eigen::Quaterniond& q_w_b) {
@@ -86,8 +107,12 @@ void Window::AddImuResidual(ImuEdge& edge) {
 
 void Window::AddStatePrior(StateId id, const StatePrior& prior) {
   State& s = state(id);
-  const Eigen::Matrix<double, 6, 6> information = prior.pose_covariance.inverse();
-  const Eigen::Matrix<double, 6, 6> sqrt_information = information.llt().matrixU();
+  const Eigen::LLT<Eigen::Matrix<double, 6, 6>> covariance(prior.pose_covariance);
+  CHECK(covariance.info() == Eigen::Success) << "state prior covariance is not positive definite";
+  const Eigen::LLT<Eigen::Matrix<double, 6, 6>> information(
+      covariance.solve(Eigen::Matrix<double, 6, 6>::Identity()));
+  CHECK(information.info() == Eigen::Success) << "state prior information is not positive definite";
+  const Eigen::Matrix<double, 6, 6> sqrt_information = information.matrixU();
   Prior pose_prior{problem_->AddResidualBlock(PosePriorFactor::Create(s.p_w_b(), s.q_w_b(), sqrt_information),
                                               nullptr, s.pose),
                    {s.pose}};
@@ -185,7 +210,7 @@ SolveReport Window::Solve(const SolverOptions& options) {
   ceres::Solver::Options solver;
   ChooseLinearSolver(options.linear_solver, &solver);
   solver.max_num_iterations = options.max_iterations;
-  solver.max_solver_time_in_seconds = options.max_solver_time_s;
+  if (options.max_solver_time_s > 0) solver.max_solver_time_in_seconds = options.max_solver_time_s;
   solver.function_tolerance = options.function_tolerance;
   solver.num_threads = options.num_threads;
   solver.minimizer_progress_to_stdout = false;
@@ -197,6 +222,7 @@ SolveReport Window::Solve(const SolverOptions& options) {
   report.initial_cost = summary.initial_cost;
   report.final_cost = summary.final_cost;
   report.usable = summary.IsSolutionUsable();
+  if (!report.usable) ++health_.failed_solves;
   return report;
 }
 
@@ -254,6 +280,7 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   if (blocks.empty()) return;
   std::set<const double*> removed(blocks.begin(), blocks.end());
   ForgetResidualsOf(removed);
+  DropUnevaluableResiduals(blocks);
   ceres::ResidualBlockId prior = marginalization::MarginalizeBlocks(problem_.get(), blocks);
   if (prior != nullptr) {
     std::vector<double*> kept;
@@ -286,6 +313,25 @@ void Window::ForgetResidualsOf(const std::set<const double*>& removed) {
     bool gone = false;
     for (const double* b : it->blocks) gone = gone || removed.count(b) > 0;
     it = gone ? priors_.erase(it) : std::next(it);
+  }
+}
+
+// A residual that does not evaluate at the current point (a landmark at or
+// behind a camera, a non-finite value) would make the whole marginalization
+// fail: it is dropped with a warning instead. Bookkeeping is already gone.
+void Window::DropUnevaluableResiduals(const std::vector<double*>& blocks) {
+  std::set<ceres::ResidualBlockId> checked;
+  for (double* block : blocks) {
+    std::vector<ceres::ResidualBlockId> residuals;
+    problem_->GetResidualBlocksForParameterBlock(block, &residuals);
+    for (ceres::ResidualBlockId id : residuals) {
+      if (!checked.insert(id).second || EvaluatesFinitely(*problem_, id)) continue;
+      LOG(WARNING) << "marginalization: dropped a residual of "
+                   << problem_->GetCostFunctionForResidualBlock(id)->num_residuals()
+                   << " rows that does not evaluate finitely at the current estimate";
+      problem_->RemoveResidualBlock(id);
+      ++health_.dropped_residuals;
+    }
   }
 }
 
@@ -347,13 +393,18 @@ void Window::DropState(StateId id) {
 double Window::ObservationError(StateId state_id, LandmarkId landmark_id) const {
   auto it = observations_.find({state_id, landmark_id});
   CHECK(it != observations_.end()) << "no observation of " << landmark_id.value << " in " << state_id.value;
+  return WhitenedError(state_id, landmark_id, it->second.z_px);
+}
+
+double Window::WhitenedError(StateId state_id, LandmarkId landmark_id, const Eigen::Vector3d& z_px) const {
   const State& s = state(state_id);
   const Landmark& l = landmark(landmark_id);
   double residual[3];
   const double* params[2] = {s.pose, l.p_w};
-  std::unique_ptr<ceres::CostFunction> f(StereoFactor::Create(it->second.z_px, stereo_, model_.pixel_sigma));
-  f->Evaluate(params, residual, nullptr);
-  return Eigen::Map<Eigen::Vector3d>(residual).norm();
+  std::unique_ptr<ceres::CostFunction> f(StereoFactor::Create(z_px, stereo_, model_.pixel_sigma));
+  if (!f->Evaluate(params, residual, nullptr)) return std::numeric_limits<double>::infinity();
+  const double error = Eigen::Map<Eigen::Vector3d>(residual).norm();
+  return std::isfinite(error) ? error : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace vio

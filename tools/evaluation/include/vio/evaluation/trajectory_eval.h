@@ -41,7 +41,8 @@ struct AssociationOptions {
   /// Estimate stamps at most this far outside the ground-truth span take its end sample [ns].
   Timestamp tolerance_ns = 1'000'000;
   /// Ground truth is not interpolated across gaps longer than this [ns]; such stamps are skipped.
-  Timestamp max_gap_ns = 500'000'000;
+  /// (EuRoC's is 200 Hz: 10 periods; interpolating across longer gaps gives degrees of error in fast turns.)
+  Timestamp max_gap_ns = 50'000'000;
 };
 
 /// Estimate poses paired with ground truth at the same stamps.
