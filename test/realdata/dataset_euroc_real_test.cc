@@ -4,11 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <optional>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
 #include "test_data.h"
 #include "vio/dataset/euroc_dataset.h"
+#include "vio/dataset/groundtruth_init.h"
 
 namespace vio::tools {
 namespace {
@@ -119,6 +121,20 @@ TEST(EurocReal, ImuOfAWholeSequenceReadsEverySampleInOrder) {
   ASSERT_EQ(imu.size(), 22800u);
   for (size_t i = 1; i < imu.size(); ++i) ASSERT_GT(imu[i].t_ns, imu[i - 1].t_ns) << "sample " << i;
   EXPECT_EQ(FindImuGaps(imu, 200.0).count, 0);
+}
+
+// EuRoC's Vicon world has z up: summary.json may align these runs pos+yaw.
+TEST(EurocReal, GroundTruthWorldsOfWholeSequencesAreGravityAligned) {
+  for (const std::string name : {"V2_01_easy", "MH_04_difficult"}) {
+    const std::string root = test::EurocSequence(name);
+    VIO_REQUIRE_DATA(root);
+    EurocReadOptions read;
+    read.read_features = false;
+    const EurocDataset d = ReadEuroc(root, read);
+    const std::optional<double> tilt = GroundTruthTiltDeg(d.groundtruth, d.imu, 9.81);
+    ASSERT_TRUE(tilt.has_value()) << name;
+    EXPECT_LT(*tilt, kMaxPosYawTiltDeg) << name;
+  }
 }
 
 TEST(EurocReal, V1_01_EasyMicroStereoImagesAndTumGroundTruth) {
