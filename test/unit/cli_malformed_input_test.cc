@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gmock/gmock.h>
@@ -214,6 +215,12 @@ std::function<void(const std::string&)> FeatureMovedInBothCameras(double shift_p
 // ---- the table -------------------------------------------------------------------
 
 struct MalformedRun {
+  MalformedRun(std::string name_, std::function<void(const std::string&)> mutate_, std::string args_,
+               std::string config_, int exit_code_, std::string message_, std::string summary_contains_ = "",
+               bool trajectory_rows_ = false)
+      : name(std::move(name_)), mutate(std::move(mutate_)), args(std::move(args_)), config(std::move(config_)),
+        exit_code(exit_code_), message(std::move(message_)), summary_contains(std::move(summary_contains_)),
+        trajectory_rows(trajectory_rows_) {}
   std::string name;
   std::function<void(const std::string&)> mutate;  ///< on a copy of the dataset; empty = none
   std::string args;                                ///< after `vio`; DATASET, OUT, CONFIG are replaced
@@ -248,8 +255,8 @@ std::vector<MalformedRun> Cases() {
        "before the first IMU sample", "\"status\": \"frames_skipped\"", true},
       // Impossible IMU values: an error naming file, line and column.
       {"imu accel 1e300", ImuValue(300, 4, "1e300"), kRun, "", 1, "imu0/data.csv:302: column 5", "", false},
-      {"imu gyro 1e3", ImuValue(10, 2, "1000"), kRun, "", 1, "beyond a physical gyro reading", "", false},
-      {"imu accel -1e5", ImuValue(20, 6, "-1e5"), kRun, "", 1, "beyond a physical accelerometer reading", "",
+      {"imu gyro 1e5", ImuValue(10, 2, "1e5"), kRun, "", 1, "beyond any IMU's gyro range", "", false},
+      {"imu accel -1e7", ImuValue(20, 6, "-1e7"), kRun, "", 1, "beyond any IMU's accelerometer range", "",
        false},
       // Outlier observations: rejected before the cost, counted, the run is ok.
       {"observation at u = -50", FeatureU("-50"), kRun, "", 0, "status ok", "\"rejected_outside_image\": 1", true},
@@ -315,9 +322,9 @@ std::vector<MalformedRun> Cases() {
       {"sweep jobs 0", {}, "sweep --datasets=DATASET --output_dir=OUT --jobs=0 --plots=false", "", 2,
        "--jobs must be >= 1"},
       // vio eval.
-      {"eval gap bound 0", {},
-       "eval --estimate=DATASET/mav0/cam0/data.csv --groundtruth=DATASET --max_gt_gap_s=0", "", 2,
-       "--max_gt_gap_s: 0"},
+      {"eval negative gap bound", {},
+       "eval --estimate=DATASET/mav0/cam0/data.csv --groundtruth=DATASET --max_gt_gap_s=-1", "", 2,
+       "--max_gt_gap_s: -1"},
       {"eval unknown alignment", {},
        "eval --estimate=DATASET/mav0/cam0/data.csv --groundtruth=DATASET --alignment=affine", "", 2, "affine"},
   };

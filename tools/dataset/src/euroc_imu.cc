@@ -20,10 +20,11 @@ const std::vector<std::string>& ImuColumns() {
   return kColumns;
 }
 
-// Readings beyond these are no physical IMU's (consumer and tactical IMUs
-// saturate near 35 rad/s and 160 m/s^2): a corrupt row, rejected by line.
-constexpr double kMaxGyroRadS = 100.0;
-constexpr double kMaxAccelMS2 = 2000.0;
+// Readings beyond these are no IMU's (consumer and tactical IMUs saturate
+// near 35 rad/s and 160 m/s^2; these leave room for shock sensors and unit
+// mistakes): a corrupt row, rejected by line before it reaches the estimator.
+constexpr double kMaxGyroRadS = 1e4;
+constexpr double kMaxAccelMS2 = 1e6;
 
 }  // namespace
 
@@ -31,8 +32,8 @@ std::vector<ImuSample> ReadImuCsv(const std::string& path, std::vector<int>* lin
   CsvReader reader(path, ImuColumns());
   TimestampOrder order;
   std::vector<ImuSample> imu;
-  const std::string gyro_range = "a physical gyro reading [rad/s]";
-  const std::string accel_range = "a physical accelerometer reading [m/s^2]";
+  const std::string gyro_range = "any IMU's gyro range [rad/s]";
+  const std::string accel_range = "any IMU's accelerometer range [m/s^2]";
   while (reader.NextRow()) {
     ImuSample sample;
     sample.t_ns = reader.Int64(0);
