@@ -34,7 +34,7 @@ FrameEstimate Estimator::ProcessFrame(const StereoFrame& frame) {
     AddPropagatedState(frame.t_ns);
   }
   timing.propagate_ms = MillisecondsSince(start);
-  timing.policy = policy_->Update(frame, last_state_, window_);
+  timing.policy = policy_->Update(GateObservations(frame), last_state_, window_);
   PruneImu(window_.states().begin()->second.t_ns);
   FrameEstimate estimate = Estimate(frame);
   timing.total_ms = MillisecondsSince(start);
@@ -137,6 +137,23 @@ FrameEstimate Estimator::EstimateOf(const State& s) const {
   e.gyro_bias = s.gyro_bias();
   e.accel_bias = s.accel_bias();
   return e;
+}
+
+// An observation of a landmark already in the window whose whitened
+// reprojection error at the new (IMU-predicted) state is beyond the gate is
+// an outlier: it never reaches the cost.
+StereoFrame Estimator::GateObservations(const StereoFrame& frame) {
+  StereoFrame kept = frame;
+  kept.observations.clear();
+  for (const StereoObservation& obs : frame.observations) {
+    if (window_.HasLandmark(obs.landmark) &&
+        !(window_.WhitenedError(last_state_, obs.landmark, obs.z_px) <= options_.model.max_whitened_residual)) {
+      ++rejected_observations_;
+      continue;
+    }
+    kept.observations.push_back(obs);
+  }
+  return kept;
 }
 
 FrameEstimate Estimator::Estimate(const StereoFrame& frame) const {

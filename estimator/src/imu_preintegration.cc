@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <glog/logging.h>
 
 #include "vio/estimator/so3.h"
@@ -137,10 +139,27 @@ ImuPreintegration::Deltas ImuPreintegration::CorrectedDeltas(const ImuBias& bias
 ImuPreintegration::Matrix15d ImuPreintegration::SqrtInformation() const {
   CHECK(!steps_.empty()) << "SqrtInformation of an empty preintegration";
   const Matrix15d symmetric = 0.5 * (covariance_ + covariance_.transpose());
-  const Matrix15d information = symmetric.llt().solve(Matrix15d::Identity());
-  const Eigen::LLT<Matrix15d> llt(0.5 * (information + information.transpose()));
-  CHECK(llt.info() == Eigen::Success) << "IMU preintegration covariance is not positive definite";
-  return llt.matrixU();
+  const Eigen::LLT<Matrix15d> covariance_llt(symmetric);
+  if (covariance_llt.info() == Eigen::Success) {
+    const Matrix15d information = covariance_llt.solve(Matrix15d::Identity());
+    const Eigen::LLT<Matrix15d> llt(0.5 * (information + information.transpose()));
+    if (llt.info() == Eigen::Success && llt.matrixU().toDenseMatrix().allFinite()) return llt.matrixU();
+  }
+  return SqrtInformationByEigen(symmetric);
+}
+
+// A long IMU gap (or extreme values) leaves a covariance too ill-conditioned
+// for Cholesky: W = Lambda^-1/2 V^T with the eigenvalues floored at a
+// fraction of the largest, so W^T W is the (regularized) information.
+ImuPreintegration::Matrix15d ImuPreintegration::SqrtInformationByEigen(const Matrix15d& covariance) {
+  constexpr double kRelativeFloor = 1e-9;
+  CHECK(covariance.allFinite()) << "IMU preintegration covariance is not finite (IMU values are range-checked)";
+  const Eigen::SelfAdjointEigenSolver<Matrix15d> eigen(covariance);
+  const double floor = std::max(eigen.eigenvalues().cwiseAbs().maxCoeff() * kRelativeFloor,
+                                std::numeric_limits<double>::min());
+  const Eigen::Matrix<double, 15, 1> inverse_sqrt =
+      eigen.eigenvalues().cwiseMax(floor).cwiseSqrt().cwiseInverse();
+  return inverse_sqrt.asDiagonal() * eigen.eigenvectors().transpose();
 }
 
 void ImuPreintegration::Reset() {

@@ -6,8 +6,12 @@
 namespace vio {
 namespace {
 
+constexpr double kMinCoveredFraction = 0.9;
+
 struct ImuStatistics {
   int count = 0;
+  Timestamp first_ns = 0;  // first and last sample in the window
+  Timestamp last_ns = 0;
   Eigen::Vector3d gyro_mean = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_mean = Eigen::Vector3d::Zero();
   double gyro_std = 0;   // RMS over axes of the per-axis standard deviation
@@ -19,6 +23,8 @@ ImuStatistics Statistics(const std::vector<ImuSample>& imu, Timestamp t0, Timest
   Eigen::Vector3d gyro_sq = Eigen::Vector3d::Zero(), accel_sq = Eigen::Vector3d::Zero();
   for (const ImuSample& m : imu) {
     if (m.t_ns < t0 || m.t_ns > t1) continue;
+    if (s.count == 0) s.first_ns = m.t_ns;
+    s.last_ns = m.t_ns;
     ++s.count;
     s.gyro_mean += m.gyro_rad_s;
     s.accel_mean += m.accel_m_s2;
@@ -42,6 +48,14 @@ StaticInitResult InitializeStatic(const std::vector<ImuSample>& imu, Timestamp t
   if (s.count < 10) {
     why << "only " << s.count << " IMU samples in the " << options.static_window_s << " s before t="
         << NanosToSeconds(t_ns) << " s";
+    return {std::nullopt, why.str()};
+  }
+  // The samples must span the window asked for (a few periods short at most),
+  // not just its last tenth.
+  const double covered_s = NanosToSeconds(s.last_ns - s.first_ns);
+  if (covered_s < kMinCoveredFraction * options.static_window_s) {
+    why << "the IMU does not cover " << kMinCoveredFraction * 100 << "% of the " << options.static_window_s
+        << " s static window before the frame yet";
     return {std::nullopt, why.str()};
   }
   if (s.gyro_std > options.static_max_gyro_std || s.accel_std > options.static_max_accel_std) {

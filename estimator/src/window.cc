@@ -16,6 +16,26 @@
 namespace vio {
 namespace {
 constexpr double kNoAccelThreshold = std::numeric_limits<double>::infinity();
+
+// True when the residual and its Jacobians evaluate to finite values at the
+// current point.
+bool EvaluatesFinitely(const ceres::Problem& problem, ceres::ResidualBlockId id) {
+  const ceres::CostFunction* f = problem.GetCostFunctionForResidualBlock(id);
+  std::vector<double> residuals(static_cast<size_t>(f->num_residuals()));
+  std::vector<std::vector<double>> jacobian_storage;
+  std::vector<double*> jacobians;
+  for (const int size : f->parameter_block_sizes()) {
+    jacobian_storage.emplace_back(static_cast<size_t>(size * f->num_residuals()));
+    jacobians.push_back(jacobian_storage.back().data());
+  }
+  double cost = 0.0;
+  if (!problem.EvaluateResidualBlock(id, true, &cost, residuals.data(), jacobians.data())) return false;
+  const auto finite = [](const std::vector<double>& v) {
+    return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+  };
+  return std::isfinite(cost) && finite(residuals) && std::all_of(jacobian_storage.begin(), jacobian_storage.end(), finite);
+}
+
 }  // namespace
 
 void State::SetPose(const Eigen::Vector3d& p_w_b, const Eigen::Quaterniond& q_w_b) {
@@ -87,8 +107,12 @@ void Window::AddImuResidual(ImuEdge& edge) {
 
 void Window::AddStatePrior(StateId id, const StatePrior& prior) {
   State& s = state(id);
-  const Eigen::Matrix<double, 6, 6> information = prior.pose_covariance.inverse();
-  const Eigen::Matrix<double, 6, 6> sqrt_information = information.llt().matrixU();
+  const Eigen::LLT<Eigen::Matrix<double, 6, 6>> covariance(prior.pose_covariance);
+  CHECK(covariance.info() == Eigen::Success) << "state prior covariance is not positive definite";
+  const Eigen::LLT<Eigen::Matrix<double, 6, 6>> information(
+      covariance.solve(Eigen::Matrix<double, 6, 6>::Identity()));
+  CHECK(information.info() == Eigen::Success) << "state prior information is not positive definite";
+  const Eigen::Matrix<double, 6, 6> sqrt_information = information.matrixU();
   Prior pose_prior{problem_->AddResidualBlock(PosePriorFactor::Create(s.p_w_b(), s.q_w_b(), sqrt_information),
                                               nullptr, s.pose),
                    {s.pose}};
@@ -242,12 +266,14 @@ SolveReport Window::GaussNewton(int max_steps, bool until_converged, const Solve
     if (k == 0) report.initial_cost = report.final_cost = step.cost;
     if (!step.ok) {
       report.usable = false;
+      ++health_.failed_solves;
       break;
     }
     ++report.iterations;
     double cost = 0;
     if (!EvaluateCost(problem_.get(), layout, &cost)) {
       report.usable = false;
+      ++health_.failed_solves;
       break;
     }
     report.final_cost = cost;
@@ -266,7 +292,7 @@ SolveReport Window::GaussNewton(int max_steps, bool until_converged, const Solve
 SolveReport Window::LevenbergMarquardt(const ceres::Solver::Options& base, const SolverOptions& options) {
   ceres::Solver::Options solver = base;
   ChooseLinearSolver(options.linear_solver, &solver);
-  solver.max_solver_time_in_seconds = options.max_solver_time_s;
+  if (options.max_solver_time_s > 0) solver.max_solver_time_in_seconds = options.max_solver_time_s;
   solver.num_threads = options.num_threads;
   solver.minimizer_progress_to_stdout = false;
   solver.logging_type = ceres::SILENT;
@@ -278,6 +304,7 @@ SolveReport Window::LevenbergMarquardt(const ceres::Solver::Options& base, const
   report.final_cost = summary.final_cost;
   report.usable = summary.IsSolutionUsable();
   report.converged = summary.termination_type == ceres::CONVERGENCE;
+  if (!report.usable) ++health_.failed_solves;
   return report;
 }
 
@@ -337,6 +364,10 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   options.residual_order = ResidualOrder();
   std::set<const double*> removed(blocks.begin(), blocks.end());
   ForgetResidualsOf(removed);
+  const std::set<ceres::ResidualBlockId> dropped = DropUnevaluableResiduals(blocks);
+  auto& order = options.residual_order;
+  order.erase(std::remove_if(order.begin(), order.end(), [&](ceres::ResidualBlockId id) { return dropped.count(id) > 0; }),
+              order.end());
   ceres::ResidualBlockId prior = marginalization::MarginalizeBlocks(problem_.get(), blocks, options);
   if (prior != nullptr) {
     std::vector<double*> kept;
@@ -373,6 +404,28 @@ void Window::ForgetResidualsOf(const std::set<const double*>& removed) {
     for (const double* b : it->blocks) gone = gone || removed.count(b) > 0;
     it = gone ? priors_.erase(it) : std::next(it);
   }
+}
+
+// A residual that does not evaluate at the current point (a landmark at or
+// behind a camera, a non-finite value) would make the whole marginalization
+// fail: it is dropped with a warning instead. Bookkeeping is already gone.
+std::set<ceres::ResidualBlockId> Window::DropUnevaluableResiduals(const std::vector<double*>& blocks) {
+  std::set<ceres::ResidualBlockId> checked;
+  std::set<ceres::ResidualBlockId> dropped;
+  for (double* block : blocks) {
+    std::vector<ceres::ResidualBlockId> residuals;
+    problem_->GetResidualBlocksForParameterBlock(block, &residuals);
+    for (ceres::ResidualBlockId id : residuals) {
+      if (!checked.insert(id).second || EvaluatesFinitely(*problem_, id)) continue;
+      LOG(WARNING) << "marginalization: dropped a residual of "
+                   << problem_->GetCostFunctionForResidualBlock(id)->num_residuals()
+                   << " rows that does not evaluate finitely at the current estimate";
+      problem_->RemoveResidualBlock(id);
+      dropped.insert(id);
+      ++health_.dropped_residuals;
+    }
+  }
+  return dropped;
 }
 
 void Window::RemoveStateBookkeeping(StateId id) { states_.erase(id); }
@@ -435,13 +488,18 @@ void Window::DropState(StateId id) {
 double Window::ObservationError(StateId state_id, LandmarkId landmark_id) const {
   auto it = observations_.find({state_id, landmark_id});
   CHECK(it != observations_.end()) << "no observation of " << landmark_id.value << " in " << state_id.value;
+  return WhitenedError(state_id, landmark_id, it->second.z_px);
+}
+
+double Window::WhitenedError(StateId state_id, LandmarkId landmark_id, const Eigen::Vector3d& z_px) const {
   const State& s = state(state_id);
   const Landmark& l = landmark(landmark_id);
   double residual[3];
   const double* params[2] = {s.pose, l.p_w};
-  std::unique_ptr<ceres::CostFunction> f(StereoFactor::Create(it->second.z_px, stereo_, model_.pixel_sigma));
-  f->Evaluate(params, residual, nullptr);
-  return Eigen::Map<Eigen::Vector3d>(residual).norm();
+  std::unique_ptr<ceres::CostFunction> f(StereoFactor::Create(z_px, stereo_, model_.pixel_sigma));
+  if (!f->Evaluate(params, residual, nullptr)) return std::numeric_limits<double>::infinity();
+  const double error = Eigen::Map<Eigen::Vector3d>(residual).norm();
+  return std::isfinite(error) ? error : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace vio

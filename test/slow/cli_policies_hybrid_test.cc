@@ -32,7 +32,13 @@ class PoliciesHybrid : public ::testing::Test {
     request.config.estimator.policy.window_size = 10;
     RunResult result = RunDataset(request);
     EXPECT_EQ(result.status, "ok") << policy;
-    EXPECT_EQ(result.frames_estimated, result.frames) << policy;
+    // Every frame after static initialization (IMU stillness over 1 s, 20 frames at most) and
+    // inside the IMU's span.
+    EXPECT_EQ(result.frames_estimated + result.health.frames_waiting_init + result.health.frames_before_imu +
+                  result.health.frames_after_imu,
+              result.frames)
+        << policy;
+    EXPECT_LE(result.health.frames_waiting_init, 20) << policy;
     ::testing::Test::RecordProperty(policy + "_ate_rmse_m",
                                     result.evaluation ? std::to_string(result.evaluation->ate.rmse_m) : "none");
     return result;

@@ -62,6 +62,48 @@ TEST(OptionRegistry, RejectsUnknownKeysBadTypesAndBadChoicesWithFileAndLine) {
   EXPECT_THROW(registry.Set("demo_mode", "slow"), ConfigError);
 }
 
+struct RangedOptions {
+  int size = 10;
+  double sigma = 0.5;
+  double fraction = 0.7;
+  template <class V>
+  void Visit(V& v) {
+    v("ranged_size", size, "a size [count]", AtLeast(1));
+    v("ranged_sigma", sigma, "a noise [px]", Positive());
+    v("ranged_fraction", fraction, "a fraction []", Between(0, 1));
+  }
+};
+
+TEST(OptionRegistry, RejectsValuesOutsideTheRangeNamingItAndTheKey) {
+  RangedOptions ranged;
+  OptionRegistry registry;
+  registry.Add("ranged", &ranged);
+  ExpectConfigError(registry, "ranged:\n  ranged_size: 0\n",
+                    "run.yaml:2: 'ranged_size': '0' is outside the valid range [1, inf)");
+  ExpectConfigError(registry, "ranged:\n  ranged_sigma: 0\n", "'ranged_sigma': '0' is outside the valid range (0, inf)");
+  ExpectConfigError(registry, "ranged:\n  ranged_fraction: 1.5\n", "valid range [0, 1]");
+  registry.Set("ranged_size", "1");
+  registry.Set("ranged_sigma", "1e-9");
+  registry.Set("ranged_fraction", "1");
+  EXPECT_EQ(ranged.size, 1);
+  EXPECT_EQ(ranged.fraction, 1.0);
+  EXPECT_THROW(registry.Set("ranged_size", "-1"), ConfigError);
+  EXPECT_THROW(registry.Set("ranged_sigma", "-0.5"), ConfigError);
+  EXPECT_EQ(RangeText(Between(-1, 1)), "[-1, 1]");
+}
+
+TEST(OptionRegistry, RejectsRepeatedAndNonScalarSectionsAndKeys) {
+  RangedOptions ranged;
+  OptionRegistry registry;
+  registry.Add("ranged", &ranged);
+  ExpectConfigError(registry, "ranged:\n  ranged_size: 2\nranged:\n  ranged_size: 3\n",
+                    "run.yaml:3: section 'ranged' appears twice (first on line 1)");
+  ExpectConfigError(registry, "ranged:\n  ranged_size: 2\n  ranged_size: 3\n",
+                    "run.yaml:3: key 'ranged_size' appears twice (first on line 2)");
+  ExpectConfigError(registry, "ranged:\n  ranged_size: {a: 1}\n", "run.yaml:2: 'ranged_size' must be a single value");
+  ExpectConfigError(registry, "[x]:\n  ranged_size: 2\n", "run.yaml:1: section names must be plain words");
+}
+
 TEST(OptionRegistry, FlagsOverrideYamlOnlyWhenGiven) {
   DemoOptions demo;
   OptionRegistry registry;

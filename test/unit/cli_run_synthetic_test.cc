@@ -50,7 +50,9 @@ TEST_P(EveryPolicy, TracksTheSyntheticFlight) {
   const auto& [policy, ate_bound_m] = GetParam();
   const RunResult result = RunOnSynthetic(test::MakeTempDir("run_policy_" + policy), policy);
   EXPECT_EQ(result.status, "ok") << policy;
-  EXPECT_GE(result.frames_estimated, result.frames - 2) << policy;
+  // Every frame after static initialization (IMU stillness over 1 s: 20 frames).
+  EXPECT_EQ(result.frames_estimated + result.health.frames_waiting_init, result.frames) << policy;
+  EXPECT_LE(result.health.frames_waiting_init, 21) << policy;
   ASSERT_TRUE(result.evaluation.has_value());
   EXPECT_LT(result.evaluation->ate.rmse_m, ate_bound_m) << policy;
 }
@@ -79,7 +81,9 @@ TEST(RunSynthetic, SwfTracksTheSyntheticFlight) {
   const std::string out = test::MakeTempDir("run_synthetic_out");
   const RunResult result = RunOnSynthetic(out);
   EXPECT_EQ(result.status, "ok");
-  EXPECT_GE(result.frames_estimated, result.frames - 2);
+  // Every frame after static initialization (IMU stillness over 1 s: 20 frames).
+  EXPECT_EQ(result.frames_estimated + result.health.frames_waiting_init, result.frames);
+  EXPECT_LE(result.health.frames_waiting_init, 21);
   ASSERT_TRUE(result.evaluation.has_value());
   EXPECT_LT(result.evaluation->ate.rmse_m, 0.03);
   EXPECT_LT(result.evaluation->ate.rot_rmse_deg, 1.0);

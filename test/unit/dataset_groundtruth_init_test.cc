@@ -1,6 +1,7 @@
 // `--init=groundtruth` from a pose-only (TUM) ground truth: velocity and both
 // biases derived from the poses and the IMU come back to the simulated truth;
 // a full-state (EuRoC CSV) ground truth is used as it is.
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -68,6 +69,25 @@ TEST(GroundTruthInitTest, NothingOutsideTheGroundTruthSpan) {
   const ImuSynthesis flight = Flight(9);
   EXPECT_FALSE(GroundTruthInitialState(flight.groundtruth, flight.imu, flight.groundtruth.front().t_ns - 1, 9.81, 1.0));
   EXPECT_FALSE(GroundTruthInitialState(flight.groundtruth, flight.imu, flight.groundtruth.back().t_ns + 1, 9.81, 1.0));
+}
+
+// The same flight in a world tilted by 30 degrees about x (a ground truth
+// fixed to a tilted target): the IMU's up is 30 degrees from its z.
+TEST(GroundTruthInitTest, TiltOfTheGroundTruthWorldIsMeasuredFromTheImu) {
+  const ImuSynthesis flight = Flight(3);
+  const std::optional<double> level = GroundTruthTiltDeg(flight.groundtruth, flight.imu, 9.81);
+  ASSERT_TRUE(level.has_value());
+  EXPECT_LT(*level, 2.0);  // an accelerometer bias of 0.3 m/s^2 tilts the mean by up to 1.8 degrees
+  const Eigen::Quaterniond tilt(Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()));
+  std::vector<GroundTruthState> tilted = flight.groundtruth;
+  for (GroundTruthState& s : tilted) {
+    s.p_w_b = tilt * s.p_w_b;
+    s.q_w_b = tilt * s.q_w_b;
+  }
+  const std::optional<double> measured = GroundTruthTiltDeg(tilted, flight.imu, 9.81);
+  ASSERT_TRUE(measured.has_value());
+  EXPECT_NEAR(*measured, 30.0, 2.0);
+  EXPECT_FALSE(GroundTruthTiltDeg({}, flight.imu, 9.81).has_value());
 }
 
 }  // namespace

@@ -47,6 +47,21 @@ ImuPreintegration Preintegrate(const SyntheticMotion& motion, Timestamp t0_ns, T
   return PreintegrateBetween(samples, t0_ns, t1_ns, linearization_bias, calibration);
 }
 
+// One step over an IMU gap leaves a rank-deficient covariance (the accel noise
+// drives velocity and position together): Cholesky fails, and the square-root
+// information must still be finite and a generalized inverse of it.
+TEST(ImuPreintegration, SqrtInformationOfOneLongStepIsAFiniteGeneralizedInverse) {
+  for (const double gap_s : {0.05, 0.5, 2.0, 10.0}) {
+    ImuPreintegration preintegration(ImuBias{}, ImuCalibration());
+    preintegration.Integrate(gap_s, Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d(0.5, 0.2, 9.81));
+    const ImuPreintegration::Matrix15d S = preintegration.SqrtInformation();
+    ASSERT_TRUE(S.allFinite()) << gap_s;
+    const ImuPreintegration::Matrix15d& P = preintegration.covariance();
+    const ImuPreintegration::Matrix15d P_W_P = P * (S.transpose() * S) * P;
+    EXPECT_LT((P_W_P - P).norm(), 1e-6 * P.norm()) << gap_s;
+  }
+}
+
 TEST(ImuPreintegration, ConstantRateAndAccelerationAreIntegratedExactly) {
   const SyntheticMotion motion;  // constant body rate, constant world acceleration
   const ImuPreintegration preintegration = Preintegrate(motion, 0, 1'000'000'000, kImuPeriodNs, TrueBias());

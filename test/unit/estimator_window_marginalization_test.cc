@@ -3,6 +3,8 @@
 // the landmarks other states see) must leave the optimum of what remains
 // where it was (Theorem 2.2.2 is exact to first order and the gradient is
 // zero there), and the problem must keep solving afterwards.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "synthetic_window.h"
@@ -91,6 +93,27 @@ TEST(WindowMarginalization, DroppingALandmarkRemovesItsObservations) {
   window.DropLandmark(id);
   EXPECT_FALSE(window.HasLandmark(id));
   EXPECT_EQ(window.problem().NumResidualBlocks(), residuals_before - observations);
+}
+
+// A landmark at the camera centre of the leaving state does not evaluate
+// (StereoFactor fails below 1 mm depth): marginalization drops its residual
+// with a warning instead of failing, and the window keeps solving.
+TEST(WindowMarginalization, AResidualThatDoesNotEvaluateIsDroppedNotFatal) {
+  static const WindowFixture fixture;
+  Window window(fixture.model, fixture.flight.stereo());
+  fixture.Build(window, /*first=*/70);
+  const State& oldest = window.state(StateId(0));
+  const Eigen::Vector3d camera_centre = oldest.p_w_b() + oldest.q_w_b() * window.stereo().T_b_cl.translation();
+  const LandmarkId bad(1'000'000);
+  window.AddLandmark(bad, camera_centre);
+  window.AddObservation(StateId(0), bad, Eigen::Vector3d(300, 290, 200));
+  EXPECT_TRUE(std::isinf(window.ObservationError(StateId(0), bad)));
+  std::vector<LandmarkId> landmarks = LandmarksSeenFrom(window, {StateId(0)});
+  EXPECT_NO_THROW(window.Marginalize({StateId(0)}, landmarks));
+  EXPECT_EQ(window.health().dropped_residuals, 1);
+  EXPECT_FALSE(window.HasLandmark(bad));
+  EXPECT_TRUE(window.Solve(Converge()).usable);
+  EXPECT_EQ(window.health().failed_solves, 0);
 }
 
 }  // namespace

@@ -102,6 +102,19 @@ TEST(EvalAssociation, GroundTruthGapsAreNotInterpolatedAcross) {
   EXPECT_EQ(Associate(est, gt, options).num_skipped, 0);
 }
 
+// By default a gap is 10 median intervals: a 200 Hz ground truth is not
+// interpolated across 0.2 s, one at 10 Hz still is across 0.2 s.
+TEST(EvalAssociation, DefaultGapIsTenMedianIntervals) {
+  for (const Timestamp period : {Timestamp{5'000'000}, Timestamp{100'000'000}}) {
+    std::vector<GroundTruthState> gt;
+    for (int k = 0; k < 40; ++k) gt.push_back(Pose(kT0 + k * period, Eigen::Vector3d(k, 0, 0), 0.0));
+    const Timestamp hole_start = gt.back().t_ns;
+    gt.push_back(Pose(hole_start + 200'000'000, Eigen::Vector3d(50, 0, 0), 0.0));
+    const std::vector<GroundTruthState> est = {Pose(hole_start + 100'000'000, Eigen::Vector3d::Zero(), 0.0)};
+    EXPECT_EQ(Associate(est, gt).num_skipped, period == 5'000'000 ? 1 : 0) << period;
+  }
+}
+
 TEST(EvalAssociation, StampsMustIncrease) {
   const std::vector<GroundTruthState> gt = GroundTruth();
   std::vector<GroundTruthState> est = {gt[1], gt[0]};

@@ -1,4 +1,5 @@
 // `vio eval`: trajectory error (ATE, RPE) of an estimate against ground truth.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -19,6 +20,9 @@ DEFINE_string(alignment, "posyaw", "estimate-to-ground-truth alignment: posyaw|s
 DEFINE_string(rpe_lengths, "1,2,5,10",
               "RPE sub-trajectory lengths along the ground truth [m], comma separated");
 DEFINE_string(json, "", "also write the report as JSON to this file (optional)");
+DEFINE_double(max_gt_gap_s, 0,
+              "ground truth is not interpolated across gaps longer than this; estimates inside are skipped; "
+              "0 = 10 median ground-truth sample intervals (EuRoC: 0.05 s) [s] valid: [0, inf)");
 
 namespace vio::tools {
 namespace {
@@ -63,6 +67,10 @@ EvalRequest RequestFromFlags(const std::vector<std::string>& args) {
   request.json_path = FLAGS_json;
   request.options.alignment = ParseAlignment(FLAGS_alignment);
   request.options.rpe_lengths_m = ParseLengths(FLAGS_rpe_lengths);
+  if (!(FLAGS_max_gt_gap_s >= 0.0) || !std::isfinite(FLAGS_max_gt_gap_s)) {
+    throw std::invalid_argument("--max_gt_gap_s: " + std::to_string(FLAGS_max_gt_gap_s) + " is not >= 0 [s]");
+  }
+  request.options.association.max_gap_ns = static_cast<Timestamp>(FLAGS_max_gt_gap_s * 1e9);
   return request;
 }
 

@@ -26,6 +26,7 @@ int RunMain(const std::vector<std::string>& args) {
             << "x real time\n";
   if (result.evaluation) std::cout << ToText(*result.evaluation);
   std::cout << "results in " << request.output_dir << "\n";
+  for (const std::string& problem : result.problems) std::cerr << "vio run: " << problem << "\n";
   return result.status == "ok" ? 0 : 1;
 }
 

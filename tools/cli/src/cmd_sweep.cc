@@ -67,7 +67,9 @@ std::vector<std::pair<std::string, int>> ParseRuns(const std::string& text) {
     if (colon == std::string::npos || colon == 0) {
       throw std::invalid_argument("--runs: '" + item + "' is not policy:window");
     }
-    runs.emplace_back(item.substr(0, colon), ParseWindowSizes(item.substr(colon + 1)).at(0));
+    const std::vector<int> window = ParseWindowSizes(item.substr(colon + 1));
+    if (window.size() != 1) throw std::invalid_argument("--runs: '" + item + "' is not policy:window");
+    runs.emplace_back(item.substr(0, colon), window.front());
   }
   return runs;
 }

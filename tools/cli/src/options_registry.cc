@@ -5,6 +5,8 @@
 #include <cmath>
 #include <deque>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <sstream>
 
 #include <gflags/gflags.h>
@@ -66,13 +68,53 @@ std::string FieldToText(const OptionField& f) {
       f.value);
 }
 
-// Assigns `text` to `field`, checking its type and choices.
+bool InRange(const OptionRange& range, double value) {
+  return value <= range.max && (range.min_exclusive ? value > range.min : value >= range.min);
+}
+
+// The field's value as a number (nothing for strings).
+std::optional<double> NumericValue(const OptionField& f) {
+  return std::visit(
+      [](auto* v) -> std::optional<double> {
+        using T = std::decay_t<decltype(*v)>;
+        if constexpr (std::is_arithmetic_v<T>) return static_cast<double>(*v);
+        else return std::nullopt;
+      },
+      f.value);
+}
+
+// Assigns `text` to `field`, checking its type, choices and range.
 std::string AssignText(OptionField& field, const std::string& text) {
   if (!field.choices.empty() &&
       std::find(field.choices.begin(), field.choices.end(), text) == field.choices.end()) {
     return "'" + text + "' is not one of " + JoinChoices(field.choices);
   }
-  return std::visit(TextParser{text}, field.value);
+  if (std::string error = std::visit(TextParser{text}, field.value); !error.empty()) return error;
+  const std::optional<double> value = NumericValue(field);
+  if (field.range && value && !InRange(*field.range, *value)) {
+    return "'" + text + "' is outside the valid range " + RangeText(*field.range);
+  }
+  return "";
+}
+
+// A map's keys as text, each once: ConfigError naming the line of a
+// non-scalar or repeated key.
+template <class Where>
+std::vector<std::pair<YAML::Node, YAML::Node>> UniqueEntries(const YAML::Node& map, const std::string& what,
+                                                             const Where& where) {
+  std::vector<std::pair<YAML::Node, YAML::Node>> entries;
+  std::map<std::string, int> first_line;
+  for (const auto& entry : map) {
+    if (!entry.first.IsScalar()) throw ConfigError(where(entry.first) + what + " names must be plain words");
+    const std::string name = entry.first.Scalar();
+    const auto [it, inserted] = first_line.emplace(name, entry.first.Mark().line + 1);
+    if (!inserted) {
+      throw ConfigError(where(entry.first) + what + " '" + name + "' appears twice (first on line " +
+                        std::to_string(it->second) + ")");
+    }
+    entries.emplace_back(entry.first, entry.second);
+  }
+  return entries;
 }
 
 // Storage of the gflags flags: gflags keeps pointers, so it must never move.
@@ -96,6 +138,7 @@ void RegisterOne(std::deque<T>& store, const OptionField& f, T value) {
   const char* name = s.texts.emplace_back(f.name).c_str();
   std::string help_text = f.doc;
   if (!f.choices.empty()) help_text += " {" + JoinChoices(f.choices) + "}";
+  if (f.range) help_text += " valid: " + RangeText(*f.range);
   const char* help = s.texts.emplace_back(help_text).c_str();
   const char* file = s.texts.emplace_back("options/" + f.section).c_str();
   T* current = &store.emplace_back(value);
@@ -104,6 +147,17 @@ void RegisterOne(std::deque<T>& store, const OptionField& f, T value) {
 }
 
 }  // namespace
+
+std::string RangeText(const OptionRange& range) {
+  const auto number = [](double x) {
+    if (std::isinf(x)) return std::string(x > 0 ? "inf" : "-inf");
+    std::ostringstream os;
+    os << x;
+    return os.str();
+  };
+  return (range.min_exclusive ? "(" : "[") + number(range.min) + ", " + number(range.max) +
+         (std::isinf(range.max) ? ")" : "]");
+}
 
 void OptionRegistry::AddField(OptionField field) {
   CHECK(Find(field.name) == nullptr) << "option '" << field.name << "' is registered twice";
@@ -147,21 +201,23 @@ void OptionRegistry::LoadYamlString(const std::string& input, const std::string&
   if (root.IsNull()) return;
   auto where = [&](const YAML::Node& n) { return origin + ":" + std::to_string(n.Mark().line + 1) + ": "; };
   if (!root.IsMap()) throw ConfigError(where(root) + "expected sections (a map) at top level");
-  for (const auto& section : root) {
-    const std::string section_name = section.first.as<std::string>();
+  for (const auto& [section_key, section] : UniqueEntries(root, "section", where)) {
+    const std::string section_name = section_key.Scalar();
     const bool known = std::any_of(fields_.begin(), fields_.end(),
                                    [&](const OptionField& f) { return f.section == section_name; });
-    if (!known) throw ConfigError(where(section.first) + "unknown section '" + section_name + "'");
-    if (!section.second.IsMap()) throw ConfigError(where(section.first) + "section '" + section_name + "' must be a map");
-    for (const auto& entry : section.second) {
-      const std::string key = entry.first.as<std::string>();
+    if (!known) throw ConfigError(where(section_key) + "unknown section '" + section_name + "'");
+    if (!section.IsMap()) {
+      throw ConfigError(where(section_key) + "section '" + section_name + "' must be a map of key: value");
+    }
+    for (const auto& [key_node, value] : UniqueEntries(section, "key", where)) {
+      const std::string key = key_node.Scalar();
       OptionField* field = Find(key);
       if (field == nullptr || field->section != section_name) {
-        throw ConfigError(where(entry.first) + "unknown key '" + key + "' in section '" + section_name + "'");
+        throw ConfigError(where(key_node) + "unknown key '" + key + "' in section '" + section_name + "'");
       }
-      if (!entry.second.IsScalar()) throw ConfigError(where(entry.second) + "'" + key + "' must be a scalar");
-      if (std::string error = AssignText(*field, entry.second.Scalar()); !error.empty()) {
-        throw ConfigError(where(entry.second) + "'" + key + "': " + error);
+      if (!value.IsScalar()) throw ConfigError(where(key_node) + "'" + key + "' must be a single value");
+      if (std::string error = AssignText(*field, value.Scalar()); !error.empty()) {
+        throw ConfigError(where(value) + "'" + key + "': " + error);
       }
     }
   }

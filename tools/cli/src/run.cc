@@ -53,47 +53,207 @@ double PeakMemoryMb() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
 }
 
-// Gives the estimator the IMU up to and including the first sample at or
-// after t_ns; false when the IMU ends before t_ns.
-bool FeedImuUpTo(const std::vector<ImuSample>& imu, Timestamp t_ns, size_t* next, Estimator* estimator) {
-  while (*next < imu.size() && (*next == 0 || imu[*next - 1].t_ns < t_ns)) estimator->AddImu(imu[(*next)++]);
-  return *next > 0 && imu[*next - 1].t_ns >= t_ns;
+// Where the frame loop is in the IMU, and the first gap it found.
+struct ImuCursor {
+  const EurocDataset& dataset;
+  double max_gap_s;
+  size_t next = 0;
+
+  // "imu0/data.csv:LINE" of sample i, and "line N" of the one before (or
+  // their times when the IMU was not read from a file).
+  bool HasLines() const { return dataset.imu_lines.size() == dataset.imu.size() && !dataset.imu_file.empty(); }
+  std::string Where(size_t i) const {
+    if (!HasLines()) return "IMU sample at t=" + std::to_string(NanosToSeconds(dataset.imu[i].t_ns)) + " s";
+    return dataset.imu_file + ":" + std::to_string(dataset.imu_lines[i]);
+  }
+  std::string Previous(size_t i) const {
+    if (!HasLines()) return "the sample at t=" + std::to_string(NanosToSeconds(dataset.imu[i].t_ns)) + " s";
+    return "line " + std::to_string(dataset.imu_lines[i]);
+  }
+
+  // Gives the estimator the IMU up to and including the first sample at or
+  // after t_ns. A gap longer than max_gap_s after initialization stops there
+  // and returns its description.
+  std::optional<std::string> FeedUpTo(Timestamp t_ns, bool initialized, Estimator* estimator) {
+    const std::vector<ImuSample>& imu = dataset.imu;
+    while (next < imu.size() && (next == 0 || imu[next - 1].t_ns < t_ns)) {
+      const double gap_s = next == 0 ? 0.0 : NanosToSeconds(imu[next].t_ns - imu[next - 1].t_ns);
+      if (initialized && gap_s > max_gap_s) {
+        std::ostringstream why;
+        why << Where(next) << ": IMU gap of " << gap_s << " s after " << Previous(next - 1)
+            << " (longer than model.max_imu_gap_s = " << max_gap_s << " s): the estimate cannot bridge it; "
+            << "the run stops at t=" << std::fixed << std::setprecision(3) << NanosToSeconds(imu[next - 1].t_ns)
+            << " s";
+        return why.str();
+      }
+      estimator->AddImu(imu[next++]);
+    }
+    return std::nullopt;
+  }
+};
+
+// Frames outside the IMU's span cannot be estimated: counted, and an error
+// when they reach further than the IMU gap the estimate bridges (a clock
+// offset between camera and IMU, or a truncated IMU file).
+void ReportFramesOutsideImu(const EurocDataset& dataset, const FrameSource& source, double max_gap_s,
+                            RunResult* result) {
+  if (dataset.imu.empty() || source.size() == 0) return;
+  const Timestamp imu_begin = dataset.imu.front().t_ns, imu_end = dataset.imu.back().t_ns;
+  const double before_s = NanosToSeconds(imu_begin - source.time(0));
+  const double after_s = NanosToSeconds(source.time(source.size() - 1) - imu_end);
+  for (size_t k = 0; k < source.size(); ++k) {
+    if (source.time(k) < imu_begin) ++result->health.frames_before_imu;
+    if (source.time(k) > imu_end) ++result->health.frames_after_imu;
+  }
+  std::ostringstream why;
+  if (before_s > max_gap_s) {
+    why << result->health.frames_before_imu << " frames (" << before_s << " s) before the first IMU sample ("
+        << dataset.imu_file << "); ";
+  }
+  if (after_s > max_gap_s) {
+    why << result->health.frames_after_imu << " frames (" << after_s << " s) after the last IMU sample ("
+        << dataset.imu_file << "); ";
+  }
+  if (why.str().empty()) return;
+  const std::string message = why.str() + "they are not estimated (camera/IMU clock offset or truncated IMU?)";
+  LOG(WARNING) << message;
+  result->problems.push_back(message);
+  if (result->status == "ok") result->status = "frames_skipped";
+}
+
+// Ends the loop at frame k with `status`: the frames left are counted.
+void StopAt(size_t k, size_t num_frames, const std::string& status, const std::string& message, RunResult* result) {
+  LOG(ERROR) << message;
+  result->status = status;
+  result->problems.push_back(message);
+  result->health.frames_after_stop = static_cast<int>(num_frames - k);
 }
 
 // The frame loop: IMU, (ground-truth start), front end, estimator, output.
+// Bad data mid-run ends the loop with a status; what was estimated is kept.
 void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, FrameSource& source,
                     Estimator& estimator, RunOutput& output, RunResult* result) {
   const auto num_frames = static_cast<std::int64_t>(source.size());
   ProgressBar progress = request.show_progress ? ProgressBar(num_frames, "frames")
                                                : ProgressBar(num_frames, "frames", nullptr, false);
   const bool init_from_gt = request.config.estimator.init.init == "groundtruth";
-  size_t next_imu = 0;
+  ImuCursor imu{dataset, request.config.estimator.model.max_imu_gap_s};
   for (size_t k = 0; k < source.size(); ++k) {
-    if (!FeedImuUpTo(dataset.imu, source.time(k), &next_imu, &estimator)) break;
-    if (init_from_gt && result->frames_estimated == 0) {
-      const InitOptions& init = request.config.estimator.init;
-      const std::optional<InitialState> gt = GroundTruthInitialState(
-          dataset.groundtruth, dataset.imu, source.time(k), request.config.estimator.model.gravity, init.static_window_s);
-      if (!gt) continue;  // frame before the ground-truth span: no state to start from
-      estimator.SetInitialState(*gt);
-    }
-    const FrameEstimate estimate = estimator.ProcessFrame(source.Frame(k, estimator));
-    progress.Update(static_cast<std::int64_t>(k + 1));
-    if (!estimate.initialized) continue;
-    if (Diverged(estimate)) {
-      result->status = "diverged";
-      LOG(ERROR) << "estimate diverged at t=" << NanosToSeconds(estimate.t_ns) << " s (frame " << k << ")";
+    const Timestamp t_ns = source.time(k);
+    if (dataset.imu.empty() || t_ns < dataset.imu.front().t_ns) continue;  // counted by ReportFramesOutsideImu
+    if (t_ns > dataset.imu.back().t_ns) break;
+    try {
+      if (auto gap = imu.FeedUpTo(t_ns, result->frames_estimated > 0, &estimator)) {
+        StopAt(k, source.size(), "imu_gap", *gap, result);
+        break;
+      }
+      if (init_from_gt && result->frames_estimated == 0) {
+        const InitOptions& init = request.config.estimator.init;
+        const std::optional<InitialState> gt = GroundTruthInitialState(
+            dataset.groundtruth, dataset.imu, t_ns, request.config.estimator.model.gravity, init.static_window_s);
+        if (!gt) {  // frame before the ground-truth span: no state to start from
+          ++result->health.frames_waiting_init;
+          continue;
+        }
+        estimator.SetInitialState(*gt);
+      }
+      const FrameEstimate estimate = estimator.ProcessFrame(source.Frame(k, estimator));
+      progress.Update(static_cast<std::int64_t>(k + 1));
+      if (!estimate.initialized) {
+        ++result->health.frames_waiting_init;
+        continue;
+      }
+      if (Diverged(estimate)) {
+        StopAt(k, source.size(), "diverged",
+               "estimate diverged at t=" + std::to_string(NanosToSeconds(estimate.t_ns)) + " s (frame " +
+                   std::to_string(k) + "): |p| > 10 km, |v| > 100 m/s or not finite",
+               result);
+        break;
+      }
+      output.AddFrame(estimate);
+      ++result->frames_estimated;
+    } catch (const std::exception& e) {
+      StopAt(k, source.size(), "failed",
+             "frame " + std::to_string(k) + " (t=" + std::to_string(NanosToSeconds(t_ns)) + " s): " + e.what(),
+             result);
       break;
     }
-    output.AddFrame(estimate);
-    ++result->frames_estimated;
   }
   progress.Finish();
+}
+
+// The offline policy's final estimates replace the per-frame ones.
+void FinishEstimates(Estimator& estimator, RunOutput& output, RunResult* result) {
+  try {
+    output.ReplaceEstimates(estimator.Finish());
+  } catch (const std::exception& e) {
+    const std::string message = std::string("final solve: ") + e.what() + " (the per-frame estimates are kept)";
+    LOG(ERROR) << message;
+    result->status = "failed";
+    result->problems.push_back(message);
+  }
+}
+
+// Counts from the estimator, and the statuses that need the whole run.
+void FinishStatus(const Estimator& estimator, RunResult* result) {
+  result->health.rejected_observations = estimator.rejected_observations();
+  result->health.dropped_residuals = estimator.window().health().dropped_residuals;
+  result->health.failed_solves = estimator.window().health().failed_solves;
+  if (result->frames_estimated == 0 && result->status == "ok") result->status = "not_initialized";
+  if (result->health.failed_solves > 0) {
+    result->problems.push_back(std::to_string(result->health.failed_solves) +
+                               " solves ended without a usable solution");
+    if (result->status == "ok") result->status = "solver_failure";
+  }
+  if (result->health.dropped_residuals > 0) {
+    result->problems.push_back(std::to_string(result->health.dropped_residuals) +
+                               " residuals did not evaluate at marginalization and were dropped");
+  }
+}
+
+// ATE RMSE beyond 0.5 m + 5% of the ground-truth path is no estimate: the
+// documented sanity bound of status "drifted".
+void CheckDrift(const TrajectoryEvaluation& evaluation, double path_length_m, RunResult* result) {
+  const double bound_m = 0.5 + 0.05 * path_length_m;
+  if (evaluation.ate.rmse_m <= bound_m) return;
+  std::ostringstream why;
+  why << "ATE RMSE " << evaluation.ate.rmse_m << " m exceeds the sanity bound " << bound_m
+      << " m (0.5 m + 5% of the " << path_length_m << " m ground-truth path)";
+  LOG(ERROR) << why.str();
+  result->problems.push_back(why.str());
+  if (result->status == "ok") result->status = "drifted";
+}
+
+double PathLength(const std::vector<GroundTruthState>& gt, Timestamp from_ns, Timestamp to_ns) {
+  double length = 0;
+  for (size_t i = 1; i < gt.size(); ++i) {
+    if (gt[i - 1].t_ns >= from_ns && gt[i].t_ns <= to_ns) length += (gt[i].p_w_b - gt[i - 1].p_w_b).norm();
+  }
+  return length;
+}
+
+// pos+yaw alignment assumes both worlds have z up; a ground truth whose world
+// is tilted (a calibration target) is aligned in SE3.
+Alignment SummaryAlignment(const EurocDataset& dataset, double gravity, RunResult* result) {
+  const std::optional<double> tilt = GroundTruthTiltDeg(dataset.groundtruth, dataset.imu, gravity);
+  result->groundtruth_tilt_deg = tilt;
+  return tilt && *tilt > kMaxPosYawTiltDeg ? Alignment::kSe3 : Alignment::kPosYaw;
+}
+
+void Evaluate(const EurocDataset& dataset, const RunRequest& request, const RunOutput& output, RunResult* result) {
+  if (dataset.groundtruth.empty() || result->frames_estimated < 3) return;
+  EvaluationOptions options;
+  options.alignment = SummaryAlignment(dataset, request.config.estimator.model.gravity, result);
+  result->evaluation = EvaluateTrajectory(output.trajectory(), dataset.groundtruth, options);
+  const std::vector<GroundTruthState>& estimated = output.trajectory();
+  CheckDrift(*result->evaluation,
+             PathLength(dataset.groundtruth, estimated.front().t_ns, estimated.back().t_ns), result);
 }
 
 }  // namespace
 
 RunResult RunDataset(const RunRequest& request) {
+  ValidateRunConfig(request.config);
   const EurocDataset dataset = ReadRunDataset(request);
   const frontend::StereoRectifier rectifier(dataset.cameras[0], dataset.cameras[1]);
   const std::unique_ptr<FrameSource> source = MakeFrameSource(request.config.frontend, dataset, rectifier);
@@ -109,14 +269,13 @@ RunResult RunDataset(const RunRequest& request) {
   }
   const auto start = std::chrono::steady_clock::now();
   EstimateFrames(request, dataset, *source, estimator, output, &result);
-  if (result.status == "ok") output.ReplaceEstimates(estimator.Finish());
+  if (result.status == "ok") FinishEstimates(estimator, output, &result);
+  ReportFramesOutsideImu(dataset, *source, request.config.estimator.model.max_imu_gap_s, &result);
   result.processing_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (result.frames_estimated == 0 && result.status == "ok") result.status = "not_initialized";
+  FinishStatus(estimator, &result);
   result.ms_per_frame = result.frames_estimated ? 1e3 * result.processing_s / result.frames_estimated : 0.0;
   result.real_time_factor = result.processing_s > 0 ? result.dataset_duration_s / result.processing_s : 0.0;
-  if (!dataset.groundtruth.empty() && result.frames_estimated >= 3) {
-    result.evaluation = EvaluateTrajectory(output.trajectory(), dataset.groundtruth);
-  }
+  Evaluate(dataset, request, output, &result);
   output.WriteTrajectory();
   output.WriteTiming();
   output.WriteSummary(result, source->ReportJson(), request, PeakMemoryMb(), estimator.waiting_reason());

@@ -20,12 +20,22 @@ void RegisterRunConfigFlags() {
   registry.RegisterFlags();
 }
 
+void ValidateRunConfig(const RunConfig& config) {
+  const PolicyOptions& policy = config.estimator.policy;
+  const bool msckf_like = policy.policy == "msckf" || policy.policy == "fixed_lag";
+  if (msckf_like && policy.window_size < 2) {
+    throw ConfigError("--window_size=" + std::to_string(policy.window_size) + ": the " + policy.policy +
+                      " policy needs a window of at least 2 states");
+  }
+}
+
 RunConfig LoadRunConfig(const std::string& yaml_path) {
   RunConfig config;
   OptionRegistry registry;
   BindRunConfig(&config, &registry);
   if (!yaml_path.empty()) registry.LoadYamlFile(yaml_path);
   registry.ApplyFlags();
+  ValidateRunConfig(config);
   return config;
 }
 

@@ -46,9 +46,28 @@ std::string JsonString(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
     if (c == '"' || c == '\\') out += '\\';
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
     out += c;
   }
   return out + "\"";
+}
+
+std::string HealthJson(const RunHealth& h) {
+  std::ostringstream os;
+  os << "{\"frames_waiting_init\": " << h.frames_waiting_init << ", \"frames_before_imu\": " << h.frames_before_imu << ", \"frames_after_imu\": " << h.frames_after_imu
+     << ", \"frames_after_stop\": " << h.frames_after_stop
+     << ", \"rejected_observations\": " << h.rejected_observations
+     << ", \"dropped_residuals\": " << h.dropped_residuals << ", \"failed_solves\": " << h.failed_solves << "}";
+  return os.str();
+}
+
+std::string ProblemsJson(const std::vector<std::string>& problems) {
+  std::string out = "[";
+  for (const std::string& p : problems) out += (out.size() > 1 ? ", " : "") + JsonString(p);
+  return out + "]";
 }
 
 }  // namespace
@@ -106,6 +125,7 @@ void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_jso
   const PolicyOptions& policy = request.config.estimator.policy;
   out << "{\n  \"dataset\": " << JsonString(request.dataset_dir) << ",\n  \"policy\": " << JsonString(policy.policy)
       << ",\n  \"window_size\": " << policy.window_size << ",\n  \"status\": " << JsonString(r.status)
+      << ",\n  \"problems\": " << ProblemsJson(r.problems) << ",\n  \"health\": " << HealthJson(r.health)
       << ",\n  \"frames\": " << r.frames << ",\n  \"frames_estimated\": " << r.frames_estimated
       << ",\n  \"dataset_duration_s\": " << Number(r.dataset_duration_s)
       << ",\n  \"processing_s\": " << Number(r.processing_s) << ",\n  \"ms_per_frame\": " << Number(r.ms_per_frame)
@@ -113,6 +133,7 @@ void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_jso
       << ",\n  \"stage_ms_per_frame\": " << StageTimesJson(frames_)
       << ",\n  \"peak_memory_mb\": " << Number(peak_memory_mb) << ",\n  \"frontend\": " << frontend_json;
   if (!waiting_reason.empty()) out << ",\n  \"not_initialized_reason\": " << JsonString(waiting_reason);
+  if (r.groundtruth_tilt_deg) out << ",\n  \"groundtruth_tilt_deg\": " << Number(*r.groundtruth_tilt_deg);
   if (r.evaluation) {
     std::string evaluation = ToJson(*r.evaluation);
     for (size_t pos = 0; (pos = evaluation.find('\n', pos)) != std::string::npos; pos += 3) {

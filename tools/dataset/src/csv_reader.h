@@ -58,6 +58,9 @@ class CsvReader {
   std::int64_t Int64(int column) const;
   /// The field as a finite double; throws quoting it when non-numeric, NaN or inf.
   double Double(int column) const;
+  /// As Double, and throws quoting it when its magnitude exceeds `max_abs`
+  /// (`what` says why, e.g. "a physical IMU reading").
+  double BoundedDouble(int column, double max_abs, const std::string& what) const;
   /// The field as decimal seconds, converted exactly to nanoseconds.
   Timestamp DecimalSeconds(int column) const;
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <sstream>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -171,6 +172,17 @@ double CsvReader::Double(int column) const {
   }
   if (!std::isfinite(value)) {
     Fail(ColumnName(column) + ": non-finite value (NaN or inf) \"" + std::string(field) + "\"");
+  }
+  return value;
+}
+
+double CsvReader::BoundedDouble(int column, double max_abs, const std::string& what) const {
+  const double value = Double(column);
+  if (std::abs(value) > max_abs) {
+    std::ostringstream bound;
+    bound << max_abs;
+    Fail(ColumnName(column) + ": \"" + std::string(Field(column)) + "\" is beyond " + what + " (|value| <= " +
+         bound.str() + ")");
   }
   return value;
 }

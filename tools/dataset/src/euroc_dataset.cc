@@ -46,7 +46,8 @@ bool HoldsAnyFile(const std::string& folder) {
 void ReadImu(const std::string& mav0, EurocDataset* dataset) {
   const std::string csv = mav0 + "/imu0/data.csv";
   dataset->imu_calibration = ReadImuYaml(mav0 + "/imu0/sensor.yaml");
-  dataset->imu = ReadImuCsv(csv);
+  dataset->imu_file = csv;
+  dataset->imu = ReadImuCsv(csv, &dataset->imu_lines);
   dataset->imu_gaps = FindImuGaps(dataset->imu, dataset->imu_calibration.rate_hz);
   if (dataset->imu_gaps.count > 0) {
     LOG(WARNING) << csv << ": " << dataset->imu_gaps.count

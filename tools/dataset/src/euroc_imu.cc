@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "csv_reader.h"
+#include "euroc_internal.h"
 #include "text_writer.h"
 #include "vio/dataset/euroc_dataset.h"
 
@@ -19,23 +20,36 @@ const std::vector<std::string>& ImuColumns() {
   return kColumns;
 }
 
+// Readings beyond these are no IMU's (consumer and tactical IMUs saturate
+// near 35 rad/s and 160 m/s^2; these leave room for shock sensors and unit
+// mistakes): a corrupt row, rejected by line before it reaches the estimator.
+constexpr double kMaxGyroRadS = 1e4;
+constexpr double kMaxAccelMS2 = 1e6;
+
 }  // namespace
 
-std::vector<ImuSample> ReadImuCsv(const std::string& path) {
+std::vector<ImuSample> ReadImuCsv(const std::string& path, std::vector<int>* lines) {
   CsvReader reader(path, ImuColumns());
   TimestampOrder order;
   std::vector<ImuSample> imu;
+  const std::string gyro_range = "any IMU's gyro range [rad/s]";
+  const std::string accel_range = "any IMU's accelerometer range [m/s^2]";
   while (reader.NextRow()) {
     ImuSample sample;
     sample.t_ns = reader.Int64(0);
     order.Check(reader, sample.t_ns);
-    sample.gyro_rad_s = {reader.Double(1), reader.Double(2), reader.Double(3)};
-    sample.accel_m_s2 = {reader.Double(4), reader.Double(5), reader.Double(6)};
+    for (int i = 0; i < 3; ++i) {
+      sample.gyro_rad_s[i] = reader.BoundedDouble(1 + i, kMaxGyroRadS, gyro_range);
+      sample.accel_m_s2[i] = reader.BoundedDouble(4 + i, kMaxAccelMS2, accel_range);
+    }
     imu.push_back(sample);
+    if (lines != nullptr) lines->push_back(reader.line());
   }
   reader.RequireRows();
   return imu;
 }
+
+std::vector<ImuSample> ReadImuCsv(const std::string& path) { return ReadImuCsv(path, nullptr); }
 
 void WriteImuCsv(const std::vector<ImuSample>& imu, const std::string& path) {
   TextWriter out(path);

@@ -10,6 +10,9 @@
 
 namespace vio::tools {
 
+/// imu0/data.csv rows, and in `lines` (when not null) the 1-based line each came from.
+std::vector<ImuSample> ReadImuCsv(const std::string& path, std::vector<int>* lines);
+
 /// camN/data.csv rows, and in `lines` the 1-based line each row came from.
 std::vector<CameraFrame> ReadCameraCsv(const std::string& path, std::vector<int>* lines);
 

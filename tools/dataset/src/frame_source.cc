@@ -35,7 +35,7 @@ class FeaturesSource final : public FrameSource {
     os << "{\"source\": \"features\", \"frames\": " << r.frames << ", \"stereo_observations\": "
        << r.stereo_observations << ", \"left_only\": " << r.left_only << ", \"right_only\": " << r.right_only
        << ", \"rejected_epipolar\": " << r.rejected_epipolar << ", \"rejected_disparity\": " << r.rejected_disparity
-       << ", \"unrectifiable\": " << r.unrectifiable << ", \"observations_off_frames\": "
+       << ", \"rejected_outside_image\": " << r.rejected_outside_image << ", \"unrectifiable\": " << r.unrectifiable << ", \"observations_off_frames\": "
        << r.observations_off_frames << "}";
     return os.str();
   }

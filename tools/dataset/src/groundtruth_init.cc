@@ -1,6 +1,7 @@
 #include "vio/dataset/groundtruth_init.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <glog/logging.h>
 
@@ -90,6 +91,30 @@ std::optional<InitialState> GroundTruthInitialState(const std::vector<GroundTrut
             << state.gyro_bias.transpose() << " rad/s, accel bias " << state.accel_bias.transpose()
             << " m/s^2 (from " << mean.samples << " IMU samples)";
   return state;
+}
+
+std::optional<double> GroundTruthTiltDeg(const std::vector<GroundTruthState>& gt, const std::vector<ImuSample>& imu,
+                                         double gravity_m_s2) {
+  if (gt.empty() || imu.empty()) return std::nullopt;
+  // The specific force in the world is a_w + g e_z; averaged, the motion cancels.
+  constexpr size_t kMaxSamples = 2000;
+  const size_t stride = std::max<size_t>(1, imu.size() / kMaxSamples);
+  const double h = static_cast<double>(kStepNs) * 1e-9;
+  Eigen::Vector3d up_sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (size_t i = 0; i < imu.size(); i += stride) {
+    const Timestamp t = imu[i].t_ns;
+    const auto before = InterpolateGroundTruth(gt, t - kStepNs);
+    const auto at = InterpolateGroundTruth(gt, t);
+    const auto after = InterpolateGroundTruth(gt, t + kStepNs);
+    if (!before || !at || !after) continue;
+    const Eigen::Vector3d a_w = (after->p_w_b - 2 * at->p_w_b + before->p_w_b) / (h * h);
+    up_sum += at->q_w_b * imu[i].accel_m_s2 - a_w;
+    ++count;
+  }
+  if (count == 0 || up_sum.norm() < 0.5 * gravity_m_s2 * count) return std::nullopt;
+  const double cos_tilt = std::clamp(up_sum.normalized().z(), -1.0, 1.0);
+  return std::acos(cos_tilt) * 180.0 / M_PI;
 }
 
 }  // namespace vio::tools

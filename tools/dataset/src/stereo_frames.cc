@@ -17,6 +17,10 @@ void AddStereoObservations(const std::map<std::int64_t, PixelPair>& rows,
   for (const auto& [id, pair] : rows) {
     if (!pair.uv[1]) { ++report->left_only; continue; }
     if (!pair.uv[0]) { ++report->right_only; continue; }
+    if (!rectifier.camera_model(0).InImage(*pair.uv[0]) || !rectifier.camera_model(1).InImage(*pair.uv[1])) {
+      ++report->rejected_outside_image;
+      continue;
+    }
     const std::optional<Eigen::Vector2d> left = rectifier.Rectify(0, *pair.uv[0]);
     const std::optional<Eigen::Vector2d> right = rectifier.Rectify(1, *pair.uv[1]);
     if (!left || !right) { ++report->unrectifiable; continue; }

@@ -63,6 +63,17 @@ bool GroundTruthAt(const std::vector<GroundTruthState>& gt, Timestamp t_ns,
   return true;
 }
 
+// The gap bound: as given, or kAutoGapPeriods median sample intervals of the
+// ground truth.
+Timestamp MaxGapNs(const std::vector<GroundTruthState>& gt, const AssociationOptions& options) {
+  if (options.max_gap_ns > 0 || gt.size() < 2) return options.max_gap_ns;
+  std::vector<Timestamp> intervals;
+  intervals.reserve(gt.size() - 1);
+  for (size_t i = 1; i < gt.size(); ++i) intervals.push_back(gt[i].t_ns - gt[i - 1].t_ns);
+  std::nth_element(intervals.begin(), intervals.begin() + intervals.size() / 2, intervals.end());
+  return kAutoGapPeriods * intervals[intervals.size() / 2];
+}
+
 }  // namespace
 
 AssociatedTrajectory Associate(const std::vector<GroundTruthState>& estimate,
@@ -70,10 +81,12 @@ AssociatedTrajectory Associate(const std::vector<GroundTruthState>& estimate,
                                const AssociationOptions& options) {
   CheckIncreasing(estimate, "estimate");
   CheckIncreasing(groundtruth, "ground truth");
+  AssociationOptions resolved = options;
+  resolved.max_gap_ns = MaxGapNs(groundtruth, options);
   AssociatedTrajectory out;
   for (const GroundTruthState& est : estimate) {
     Eigen::Isometry3d T_w_b_gt;
-    if (groundtruth.empty() || !GroundTruthAt(groundtruth, est.t_ns, options, &T_w_b_gt)) {
+    if (groundtruth.empty() || !GroundTruthAt(groundtruth, est.t_ns, resolved, &T_w_b_gt)) {
       ++out.num_skipped;
       continue;
     }

@@ -87,6 +87,15 @@ std::vector<SweepRun> PlanSweep(const SweepRequest& request) {
       for (int window : request.window_sizes) combinations.emplace_back(policy, window);
     }
   }
+  std::set<std::pair<std::string, int>> listed;
+  for (const auto& [policy, window] : combinations) {
+    CheckName("policy", policy);
+    if (window < 1) throw std::invalid_argument("window size " + std::to_string(window) + " < 1");
+    if (!listed.emplace(policy, window).second) {
+      throw std::invalid_argument("run " + policy + ":" + std::to_string(window) +
+                                  " is listed twice (each run has one folder)");
+    }
+  }
   std::vector<SweepRun> plan;
   for (const auto& [name, dir] : NamedDatasets(request.datasets)) {
     for (const auto& [policy, window] : combinations) {

@@ -61,6 +61,8 @@ class Estimator {
   const Window& window() const { return window_; }
   /// Why static initialization has not happened yet (empty once initialized).
   const std::string& waiting_reason() const { return waiting_reason_; }
+  /// Observations rejected by the whitened-residual gate (model.max_whitened_residual).
+  int rejected_observations() const { return rejected_observations_; }
 
  private:
   struct Prediction {
@@ -73,6 +75,7 @@ class Estimator {
   bool Initialize(const StereoFrame& frame);
   void AddFirstState(const InitialState& initial);
   void AddPropagatedState(Timestamp t_ns);
+  StereoFrame GateObservations(const StereoFrame& frame);
   FrameEstimate Estimate(const StereoFrame& frame) const;
   FrameEstimate EstimateOf(const State& state) const;
   void PruneImu(Timestamp before_ns);
@@ -86,6 +89,7 @@ class Estimator {
   StateId last_state_;
   std::int64_t next_state_id_ = 0;
   std::string waiting_reason_;
+  int rejected_observations_ = 0;
 };
 
 }  // namespace vio

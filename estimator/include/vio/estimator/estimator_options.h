@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "vio/estimator/option_range.h"
+
 namespace vio {
 
 /// Which policy over build / Gauss-Newton / marginalize runs (paper ch. 4).
@@ -26,7 +28,7 @@ struct PolicyOptions {
       "marginalized before one GN step), iekf (iterated EKF: GN to convergence), fixed_lag (MSCKF "
       "marginalization, GN to convergence), keyframe (OKVIS-like), batch (no marginalization)",
       {"swf", "msckf", "ekf", "iekf", "fixed_lag", "keyframe", "batch"});
-    v("window_size", window_size, "states kept in the sliding window [frames]");
+    v("window_size", window_size, "states kept in the sliding window [frames]", AtLeast(1));
     v("swf_landmarks", swf_landmarks,
       "SWF: landmarks seen by the leaving state are kept (paper-exact, prior over them) "
       "or marginalized with it (prior over states only, faster)",
@@ -36,10 +38,10 @@ struct PolicyOptions {
       "those the newest frame did not observe are marginalized after the update (marginalize_unseen, bounded)",
       {"keep", "marginalize_unseen"});
     v("keyframe_temporal_window", keyframe_temporal_window,
-      "keyframe policy: the most recent frames, always kept [frames]");
+      "keyframe policy: the most recent frames, always kept [frames]", AtLeast(1));
     v("keyframe_overlap", keyframe_overlap,
       "keyframe policy: a frame sharing less than this fraction of its landmarks with the last keyframe "
-      "becomes a keyframe []");
+      "becomes a keyframe []", Between(0, 1));
   }
 };
 
@@ -57,16 +59,16 @@ struct MsckfOptions {
 
   template <class V>
   void Visit(V& v) {
-    v("msckf_gn_steps", msckf_gn_steps, "MSCKF: Gauss-Newton steps per update (fixed_lag: to convergence) [count]");
+    v("msckf_gn_steps", msckf_gn_steps, "MSCKF: Gauss-Newton steps per update (fixed_lag: to convergence) [count]", AtLeast(1));
     v("msckf_leaving_update", msckf_leaving_update,
       "MSCKF: a track seen from a leaving state is used whole and restarts (whole_track), or gives only its views "
       "from the leaving states when seen from all of them and goes on (leaving_views, paper Algorithm 4)",
       {"whole_track", "leaving_views"});
-    v("msckf_min_track_length", msckf_min_track_length, "MSCKF: observations a track needs to be used [frames]");
+    v("msckf_min_track_length", msckf_min_track_length, "MSCKF: observations a track needs to be used [frames]", AtLeast(2));
     v("msckf_max_reprojection", msckf_max_reprojection,
-      "MSCKF triangulation: largest whitened reprojection error [sigma]");
+      "MSCKF triangulation: largest whitened reprojection error [sigma]", Positive());
     v("msckf_max_landmark_sigma", msckf_max_landmark_sigma,
-      "MSCKF triangulation: largest landmark position standard deviation [m]");
+      "MSCKF triangulation: largest landmark position standard deviation [m]", Positive());
   }
 };
 
@@ -79,9 +81,9 @@ struct BatchOptions {
   template <class V>
   void Visit(V& v) {
     v("batch_final_iterations", batch_final_iterations,
-      "batch: Gauss-Newton iterations of the final solve over every state and landmark [count]");
+      "batch: Gauss-Newton iterations of the final solve over every state and landmark [count]", AtLeast(1));
     v("batch_solve_every", batch_solve_every,
-      "batch: while running, solve the recent states every this many frames (IMU prediction between) [frames]");
+      "batch: while running, solve the recent states every this many frames (IMU prediction between) [frames]", AtLeast(1));
   }
 };
 
@@ -92,7 +94,7 @@ struct SolverOptions {
   std::string step = "gn";
   int max_iterations = 10;        ///< most steps of a to-convergence solve (a safety net) [count]
   double parameter_tolerance = 1e-8;  ///< gn: converged when |dx| <= this * (|x| + this) []
-  double max_solver_time_s = 1.0;   ///< wall-time bound per solve [s] (a run that hits it is not reproducible)
+  double max_solver_time_s = 0.0;   ///< wall-time bound per solve [s]; 0 = none (a run that hits one is not reproducible)
   double function_tolerance = 1e-4;  ///< relative cost change that counts as converged []
   int num_threads = 1;            ///< Ceres threads [count]
   std::string linear_solver = "dense";  ///< dense | sparse (Schur-reduced) | sparse_full (whole system) | iterative
@@ -105,18 +107,21 @@ struct SolverOptions {
       {"gn", "lm"});
     v("max_iterations", max_iterations,
       "most Gauss-Newton steps of a solve to convergence, a safety net (the criterion is function_tolerance / "
-      "parameter_tolerance) [count]");
+      "parameter_tolerance) [count]",
+      AtLeast(1));
     v("parameter_tolerance", parameter_tolerance,
-      "gn: converged when the step |dx| <= this * (|x| + this) []");
+      "gn: converged when the step |dx| <= this * (|x| + this) []", Positive(1));
     v("linear_solver", linear_solver,
       "dense or sparse Cholesky of the Schur-reduced system (sparse: large windows), sparse_full (sparse Cholesky "
       "of the whole system, states eliminated before landmarks: whole sequences, batch's final solve) or iterative "
       "(preconditioned conjugate gradients on the reduced system)",
       {"dense", "sparse", "sparse_full", "iterative"});
     v("max_solver_time_s", max_solver_time_s,
-      "wall-time bound of one solve [s]; a safety net: a run that hits it is not reproducible");
-    v("function_tolerance", function_tolerance, "relative cost change that counts as converged []");
-    v("num_threads", num_threads, "Ceres threads [count]");
+      "wall-time bound of one solve [s]; 0 = none (default: results do not depend on machine load); a run that "
+      "hits a bound is not reproducible",
+      AtLeast(0));
+    v("function_tolerance", function_tolerance, "relative cost change that counts as converged []", Positive(1));
+    v("num_threads", num_threads, "Ceres threads [count]", Between(1, 256));
   }
 };
 
@@ -129,17 +134,27 @@ struct ModelOptions {
   double min_disparity_px = 1.0;   ///< new landmarks need at least this stereo disparity [px]
   double max_depth_m = 30.0;       ///< new landmarks beyond this depth are not added [m]
   double reintegrate_bias_threshold = 0.01;  ///< re-preintegrate when the gyro bias moved [rad/s]
+  double max_whitened_residual = 50.0;  ///< observations of window landmarks predicted worse are rejected [sigma]
+  double max_imu_gap_s = 0.1;          ///< longest IMU gap the estimate bridges; a longer one ends the run [s]
 
   template <class V>
   void Visit(V& v) {
-    v("pixel_sigma", pixel_sigma, "stereo measurement noise of each of (u_L, u_R, v) [px]");
-    v("huber_px", huber_px, "Huber loss threshold on whitened residuals [sigma]; 0 disables it");
-    v("gravity", gravity, "gravity magnitude along world -z [m/s^2]");
-    v("imu_noise_scale", imu_noise_scale, "factor on the IMU noise densities of sensor.yaml []");
-    v("min_disparity_px", min_disparity_px, "smallest stereo disparity of a new landmark [px]");
-    v("max_depth_m", max_depth_m, "largest depth of a new landmark [m]");
+    v("pixel_sigma", pixel_sigma, "stereo measurement noise of each of (u_L, u_R, v) [px]", Positive());
+    v("huber_px", huber_px, "Huber loss threshold on whitened residuals [sigma]; 0 disables it", AtLeast(0));
+    v("gravity", gravity, "gravity magnitude along world -z [m/s^2]", Positive());
+    v("imu_noise_scale", imu_noise_scale, "factor on the IMU noise densities of sensor.yaml []", Positive());
+    v("min_disparity_px", min_disparity_px, "smallest stereo disparity of a new landmark [px]", AtLeast(0));
+    v("max_depth_m", max_depth_m, "largest depth of a new landmark [m]", Positive());
     v("reintegrate_bias_threshold", reintegrate_bias_threshold,
-      "gyro-bias change that triggers re-preintegration [rad/s]");
+      "gyro-bias change that triggers re-preintegration [rad/s]", AtLeast(0));
+    v("max_whitened_residual", max_whitened_residual,
+      "an observation of a landmark in the window whose whitened reprojection error at the IMU-predicted state "
+      "exceeds this is rejected before it reaches the cost [sigma]",
+      Positive());
+    v("max_imu_gap_s", max_imu_gap_s,
+      "longest gap between IMU samples the estimate bridges; at a longer one the run stops (status imu_gap) and "
+      "frames outside the IMU's span by more than this are reported (status frames_skipped) [s]",
+      Positive());
   }
 };
 
@@ -159,15 +174,17 @@ struct InitOptions {
   template <class V>
   void Visit(V& v) {
     v("init", init, "initialization: static (IMU stillness) or groundtruth", {"static", "groundtruth"});
-    v("static_window_s", static_window_s, "IMU span averaged for the initial biases (static: also gravity; groundtruth: either side of the start) [s]");
-    v("static_max_gyro_std", static_max_gyro_std, "stillness: largest gyro standard deviation [rad/s]");
-    v("static_max_accel_std", static_max_accel_std, "stillness: largest accel standard deviation [m/s^2]");
-    v("prior_position_sigma", prior_position_sigma, "first-pose prior on position [m]");
-    v("prior_yaw_sigma", prior_yaw_sigma, "first-pose prior on yaw [rad]");
-    v("prior_tilt_sigma", prior_tilt_sigma, "first-pose prior on roll and pitch [rad]");
-    v("prior_velocity_sigma", prior_velocity_sigma, "first-state prior on velocity [m/s]");
-    v("prior_gyro_bias_sigma", prior_gyro_bias_sigma, "first-state prior on the gyro bias [rad/s]");
-    v("prior_accel_bias_sigma", prior_accel_bias_sigma, "first-state prior on the accel bias [m/s^2]");
+    v("static_window_s", static_window_s,
+      "IMU span averaged for the initial biases (static: also gravity; groundtruth: either side of the start) [s]",
+      Positive());
+    v("static_max_gyro_std", static_max_gyro_std, "stillness: largest gyro standard deviation [rad/s]", Positive());
+    v("static_max_accel_std", static_max_accel_std, "stillness: largest accel standard deviation [m/s^2]", Positive());
+    v("prior_position_sigma", prior_position_sigma, "first-pose prior on position [m]", Positive());
+    v("prior_yaw_sigma", prior_yaw_sigma, "first-pose prior on yaw [rad]", Positive());
+    v("prior_tilt_sigma", prior_tilt_sigma, "first-pose prior on roll and pitch [rad]", Positive());
+    v("prior_velocity_sigma", prior_velocity_sigma, "first-state prior on velocity [m/s]", Positive());
+    v("prior_gyro_bias_sigma", prior_gyro_bias_sigma, "first-state prior on the gyro bias [rad/s]", Positive());
+    v("prior_accel_bias_sigma", prior_accel_bias_sigma, "first-state prior on the accel bias [m/s^2]", Positive());
   }
 };
 

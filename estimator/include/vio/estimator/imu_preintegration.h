@@ -96,7 +96,9 @@ class ImuPreintegration {
   const ImuBias& linearization_bias() const { return linearization_bias_; }
   /// Covariance of [dphi, dv, dp, db_g, db_a] (bias rows: random walk).
   const Matrix15d& covariance() const { return covariance_; }
-  /// Upper-triangular S with S^T S = covariance()^-1 (whitens residuals);
+  /// S with S^T S = covariance()^-1 (whitens residuals): upper-triangular
+  /// (Cholesky), or from the eigen-decomposition with the eigenvalues floored
+  /// when a long IMU gap makes the covariance too ill-conditioned for it;
   /// requires num_steps() > 0.
   Matrix15d SqrtInformation() const;
 
@@ -113,6 +115,7 @@ class ImuPreintegration {
     Eigen::Vector3d gyro_a, gyro_b, accel_a, accel_b;
   };
 
+  static Matrix15d SqrtInformationByEigen(const Matrix15d& covariance);
   void Reset();
   void Propagate(const Step& step);
   Eigen::Matrix3d Block(int row, int col) const { return jacobian_.block<3, 3>(row, col); }

@@ -71,6 +71,12 @@ struct Removals {
   std::vector<LandmarkId> dropped_landmarks;  ///< incl. those a dropped state left unobserved
 };
 
+/// What went wrong in the window and was survived, counted over its life.
+struct WindowHealth {
+  int dropped_residuals = 0;  ///< residuals that did not evaluate (or not finitely) when marginalized: dropped
+  int failed_solves = 0;      ///< solves whose result Ceres reported unusable
+};
+
 class Window {
  public:
   Window(const ModelOptions& model, const RectifiedStereo& stereo);
@@ -133,8 +139,13 @@ class Window {
   const Landmark& landmark(LandmarkId id) const;
   /// Whitened stereo reprojection error of one observation [sigma].
   double ObservationError(StateId state, LandmarkId landmark) const;
+  /// Whitened stereo reprojection error of a measurement z = (u_L, u_R, v) of
+  /// `landmark` from `state` at the current estimate [sigma]; +inf when the
+  /// landmark is (nearly) at or behind the camera.
+  double WhitenedError(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px) const;
   const RectifiedStereo& stereo() const { return stereo_; }
   int num_priors() const { return static_cast<int>(priors_.size()); }
+  const WindowHealth& health() const { return health_; }
   ceres::Problem& problem() { return *problem_; }
 
  private:
@@ -168,6 +179,7 @@ class Window {
   std::shared_ptr<ceres::ParameterBlockOrdering> StatesFirstOrdering() const;
   void ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const;
   void ForgetResidualsOf(const std::set<const double*>& removed_blocks);
+  std::set<ceres::ResidualBlockId> DropUnevaluableResiduals(const std::vector<double*>& blocks);
   void RemoveStateBookkeeping(StateId id);
 
   ModelOptions model_;
@@ -181,6 +193,7 @@ class Window {
   std::map<ObservationKey, Observation> observations_;
   std::vector<Prior> priors_;
   Removals removals_;
+  WindowHealth health_;
 };
 
 }  // namespace vio

@@ -3,6 +3,8 @@
 // and the parameters of the two image front ends (paper §5.2 BRISK, KLT).
 #include <string>
 
+#include "vio/estimator/option_range.h"
+
 namespace vio {
 
 struct FrontendOptions {
@@ -52,25 +54,25 @@ struct FrontendOptions {
       "source of stereo observations: features = the dataset's features0/data.csv, brisk = BRISK matching on "
       "the images (paper 5.2), klt = Lucas-Kanade tracking on the images",
       {"features", "brisk", "klt"});
-    v("max_epipolar_px", max_epipolar_px, "reject stereo pairs whose rectified rows differ by more [px]");
-    v("grid_cell_px", grid_cell_px, "side of the grid cells spreading image features [px]");
+    v("max_epipolar_px", max_epipolar_px, "reject stereo pairs whose rectified rows differ by more [px]", Positive());
+    v("grid_cell_px", grid_cell_px, "side of the grid cells spreading image features [px]", AtLeast(1));
     v("max_reprojection_px", max_reprojection_px,
-      "reject temporal matches further from their IMU-predicted reprojection [px]");
-    v("brisk_threshold", brisk_threshold, "BRISK AGAST detection threshold [grey levels]");
-    v("brisk_octaves", brisk_octaves, "BRISK scale-space octaves [count]");
-    v("brisk_per_cell", brisk_per_cell, "BRISK keypoints kept per grid cell and image [count]");
-    v("max_hamming_bits", max_hamming_bits, "largest Hamming distance of a BRISK match [bits of 512]");
+      "reject temporal matches further from their IMU-predicted reprojection [px]", Positive());
+    v("brisk_threshold", brisk_threshold, "BRISK AGAST detection threshold [grey levels]", Between(0, 255));
+    v("brisk_octaves", brisk_octaves, "BRISK scale-space octaves [count]", Between(0, 8));
+    v("brisk_per_cell", brisk_per_cell, "BRISK keypoints kept per grid cell and image [count]", AtLeast(1));
+    v("max_hamming_bits", max_hamming_bits, "largest Hamming distance of a BRISK match [bits of 512]", Between(0, 512));
     v("track_window_frames", track_window_frames,
-      "BRISK matches the new frame to tracks seen in this many previous frames [frames]");
-    v("klt_per_cell", klt_per_cell, "KLT most features per grid cell [count]");
-    v("klt_max_features", klt_max_features, "KLT most features in the image [count]");
-    v("klt_fast_threshold", klt_fast_threshold, "KLT FAST corner threshold [grey levels]");
-    v("klt_min_distance_px", klt_min_distance_px, "KLT minimum distance between features [px]");
-    v("klt_window_px", klt_window_px, "KLT Lucas-Kanade window side [px]");
-    v("klt_pyramid_levels", klt_pyramid_levels, "KLT pyramid levels above the full image [count]");
-    v("klt_max_fb_px", klt_max_fb_px, "KLT largest forward-backward tracking error [px]");
-    v("klt_max_disparity_px", klt_max_disparity_px, "KLT largest disparity the stereo row search tries [px]");
-    v("klt_min_ncc", klt_min_ncc, "KLT smallest ZNCC score of a stereo row-search match [-1, 1]");
+      "BRISK matches the new frame to tracks seen in this many previous frames [frames]", AtLeast(1));
+    v("klt_per_cell", klt_per_cell, "KLT most features per grid cell [count]", AtLeast(1));
+    v("klt_max_features", klt_max_features, "KLT most features in the image [count]", AtLeast(1));
+    v("klt_fast_threshold", klt_fast_threshold, "KLT FAST corner threshold [grey levels]", Between(0, 255));
+    v("klt_min_distance_px", klt_min_distance_px, "KLT minimum distance between features [px]", AtLeast(0));
+    v("klt_window_px", klt_window_px, "KLT Lucas-Kanade window side [px]", AtLeast(3));
+    v("klt_pyramid_levels", klt_pyramid_levels, "KLT pyramid levels above the full image [count]", Between(0, 8));
+    v("klt_max_fb_px", klt_max_fb_px, "KLT largest forward-backward tracking error [px]", Positive());
+    v("klt_max_disparity_px", klt_max_disparity_px, "KLT largest disparity the stereo row search tries [px]", Positive());
+    v("klt_min_ncc", klt_min_ncc, "KLT smallest ZNCC score of a stereo row-search match [-1, 1]", Between(-1, 1));
     v("debug_images", debug_images, "folder for one PNG per frame with the tracks drawn; empty = none");
   }
 };

@@ -13,12 +13,17 @@
 //     }
 //   };
 //
-// String fields may list their allowed values: v("policy", policy, "doc", {"swf", "msckf"}).
+// String fields may list their allowed values: v("policy", policy, "doc", {"swf", "msckf"});
+// numeric fields their valid range: v("window_size", window_size, "doc", AtLeast(1)).
 #include <memory>
+#include <optional>
 #include <stdexcept>
+#include <type_traits>
 #include <string>
 #include <variant>
 #include <vector>
+
+#include "vio/estimator/option_range.h"
 
 namespace vio::tools {
 
@@ -36,7 +41,11 @@ struct OptionField {
   std::string doc;      ///< one line with units
   std::variant<bool*, int*, std::int64_t*, double*, std::string*> value;
   std::vector<std::string> choices;  ///< allowed values of a string option; empty = any
+  std::optional<OptionRange> range;  ///< valid values of a numeric option; none = any
 };
+
+/// "[1, inf)", "(0, 1]": the range as shown in messages and --help.
+std::string RangeText(const OptionRange& range);
 
 class OptionRegistry {
  public:
@@ -48,8 +57,9 @@ class OptionRegistry {
   }
 
   /// Sets fields from a YAML file: top-level keys are sections, their keys are
-  /// fields. Unknown sections or keys, wrong types and bad choices are errors
-  /// (ConfigError naming file:line). A `%YAML:1.0` first line is accepted.
+  /// fields. Unknown, duplicated or non-scalar sections or keys, wrong types,
+  /// bad choices and values outside the range are errors (ConfigError naming
+  /// file:line and key). A `%YAML:1.0` first line is accepted.
   void LoadYamlFile(const std::string& path);
   void LoadYamlString(const std::string& text, const std::string& origin = "<string>");
 
@@ -75,7 +85,12 @@ class OptionRegistry {
     template <class T>
     void operator()(const char* name, T& value, const char* doc,
                     std::vector<std::string> choices = {}) {
-      registry->AddField(OptionField{section, name, doc, &value, std::move(choices)});
+      registry->AddField(OptionField{section, name, doc, &value, std::move(choices), std::nullopt});
+    }
+    template <class T>
+    void operator()(const char* name, T& value, const char* doc, OptionRange range) {
+      static_assert(std::is_arithmetic_v<T>, "a range needs a numeric option");
+      registry->AddField(OptionField{section, name, doc, &value, {}, range});
     }
   };
   void AddField(OptionField field);

@@ -9,6 +9,7 @@
 //   config.yaml     the effective configuration
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "vio/cli/run_config.h"
 #include "vio/evaluation/trajectory_eval.h"
@@ -22,14 +23,35 @@ struct RunRequest {
   bool show_progress = true; ///< progress bar (only drawn on a terminal)
 };
 
+/// What a run could not do or had to reject (summary.json "health").
+struct RunHealth {
+  int frames_waiting_init = 0;    ///< frames before initialization (static: IMU stillness over static_window_s)
+  int frames_before_imu = 0;      ///< frames before the first IMU sample: not estimated
+  int frames_after_imu = 0;       ///< frames after the last IMU sample: not estimated
+  int frames_after_stop = 0;      ///< frames not processed because the run stopped early
+  int rejected_observations = 0;  ///< observations beyond the whitened-residual gate
+  int dropped_residuals = 0;      ///< residuals that did not evaluate at marginalization
+  int failed_solves = 0;          ///< solves without a usable solution
+};
+
 struct RunResult {
-  std::string status = "ok";     ///< ok | diverged | not_initialized
+  /// ok: every frame from initialization on estimated, every solve usable,
+  /// within the sanity bounds; else the first of: imu_gap (stopped at an IMU
+  /// gap longer than model.max_imu_gap_s), diverged (|p| > 10 km, |v| > 100
+  /// m/s or not finite), failed (an error mid-run), frames_skipped (frames
+  /// outside the IMU span by more than max_imu_gap_s), not_initialized,
+  /// solver_failure, drifted (ATE RMSE > 0.5 m + 5% of the path). Not ok =
+  /// exit code 1 of `vio run`; what was estimated is written either way.
+  std::string status = "ok";
+  std::vector<std::string> problems;  ///< one message per problem (file and line where there is one)
   int frames = 0;                ///< frames in the dataset
   int frames_estimated = 0;      ///< frames with a pose in trajectory.txt
   double dataset_duration_s = 0; ///< first to last frame [s]
   double processing_s = 0;       ///< wall time of the estimator loop [s]
   double ms_per_frame = 0;       ///< mean over estimated frames [ms]
   double real_time_factor = 0;   ///< dataset_duration_s / processing_s
+  RunHealth health;
+  std::optional<double> groundtruth_tilt_deg;  ///< tilt of the ground truth's z from up (decides the alignment)
   std::optional<TrajectoryEvaluation> evaluation;  ///< when ground truth exists
 };
 

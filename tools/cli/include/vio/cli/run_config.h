@@ -38,6 +38,10 @@ void RegisterRunConfigFlags();
 /// command line. Throws ConfigError on an unknown key or bad value.
 RunConfig LoadRunConfig(const std::string& yaml_path);
 
+/// Checks what no single option's range can: combinations (the MSCKF needs a
+/// window of at least 2). Throws ConfigError naming the option.
+void ValidateRunConfig(const RunConfig& config);
+
 /// The effective configuration as YAML (written next to every run's results).
 std::string RunConfigToYaml(RunConfig config);
 

@@ -67,6 +67,8 @@ struct EurocDataset {
   std::string root;  ///< the folder holding mav0/
   ImuCalibration imu_calibration;
   std::vector<ImuSample> imu;
+  std::string imu_file;        ///< the imu0/data.csv read (empty when not read from a file)
+  std::vector<int> imu_lines;  ///< 1-based line of each sample in imu_file (empty when not read)
   ImuGapReport imu_gaps;
   CameraCalibration cameras[2];
   std::vector<CameraFrame> frames[2];  ///< cam0, cam1 data.csv rows

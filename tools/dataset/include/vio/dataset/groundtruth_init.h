@@ -29,4 +29,14 @@ std::optional<InitialState> GroundTruthInitialState(const std::vector<GroundTrut
                                                     const std::vector<ImuSample>& imu, Timestamp t_ns,
                                                     double gravity_m_s2, double span_s);
 
+/// Largest tilt of the ground truth's world z axis from up for which pos+yaw
+/// alignment (which keeps roll and pitch) is valid [deg].
+constexpr double kMaxPosYawTiltDeg = 5.0;
+
+/// Angle between the ground truth's world z axis and up as the IMU measures it
+/// (specific force rotated into the ground-truth world, minus the ground
+/// truth's own acceleration, averaged) [deg]; nullopt without overlap.
+std::optional<double> GroundTruthTiltDeg(const std::vector<GroundTruthState>& gt, const std::vector<ImuSample>& imu,
+                                         double gravity_m_s2);
+
 }  // namespace vio::tools

@@ -17,6 +17,7 @@ struct StereoFramesReport {
   int right_only = 0;              ///< seen in cam1 only (not used)
   int rejected_epipolar = 0;       ///< rectified rows differ by more than the bound
   int rejected_disparity = 0;      ///< disparity <= 0 (behind or at infinity)
+  int rejected_outside_image = 0;  ///< a pixel outside its image (calibration resolution)
   int unrectifiable = 0;           ///< a pixel that cannot be undistorted
   int observations_off_frames = 0; ///< feature rows whose stamp is no cam0 frame
 };

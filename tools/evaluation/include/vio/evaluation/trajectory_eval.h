@@ -36,12 +36,17 @@ Alignment ParseAlignment(const std::string& name);
 /// The name ParseAlignment accepts.
 std::string AlignmentName(Alignment alignment);
 
+/// Median ground-truth sample intervals that make a gap (AssociationOptions::max_gap_ns = 0).
+constexpr Timestamp kAutoGapPeriods = 10;
+
 /// How estimate stamps are matched to ground truth.
 struct AssociationOptions {
   /// Estimate stamps at most this far outside the ground-truth span take its end sample [ns].
   Timestamp tolerance_ns = 1'000'000;
   /// Ground truth is not interpolated across gaps longer than this [ns]; such stamps are skipped.
-  Timestamp max_gap_ns = 500'000'000;
+  /// 0 = kAutoGapPeriods of the ground truth's median sample interval (EuRoC, 200 Hz: 50 ms;
+  /// interpolating across much longer gaps gives degrees of error in fast turns).
+  Timestamp max_gap_ns = 0;
 };
 
 /// Estimate poses paired with ground truth at the same stamps.
