@@ -1,6 +1,7 @@
 // Both image front ends end to end on a short synthetic sequence rendered
 // into images (`vio simulate --camera=images`, made in the test's temp dir),
-// then `vio run` with SWF(10): the run completes and the ATE stays small.
+// then `vio run` with SWF(10): the run completes and the ATE stays small; the
+// KLT run is the default one for a dataset with images and no features0.
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -43,14 +44,17 @@ class FrontendRendered : public ::testing::Test {
         << "see " << dir_ << "/simulate.log";
   }
 
-  static void ExpectAteBelow(const std::string& frontend, double bound_m) {
+  // `vio run` with `flags`; the front end that ran must be `frontend`.
+  static void ExpectAteBelow(const std::string& frontend, const std::string& flags, double bound_m) {
     const std::string out = dir_ + "/" + frontend;
-    ASSERT_EQ(RunVio("run --dataset=" + dir_ + "/data --output_dir=" + out + " --frontend=" + frontend +
+    ASSERT_EQ(RunVio("run --dataset=" + dir_ + "/data --output_dir=" + out + " " + flags +
                       " --policy=swf --window_size=10",
                   out + ".log"),
               0)
         << "see " << out << ".log";
     const std::string summary = ReadFile(out + "/summary.json");
+    EXPECT_NE(summary.find("\"source\": \"" + frontend + "\""), std::string::npos) << summary;
+    EXPECT_NE(ReadFile(out + "/config.yaml").find("frontend: " + frontend), std::string::npos);
     EXPECT_NE(summary.find("\"status\": \"ok\""), std::string::npos) << summary;
     const double ate = JsonNumber(summary, "ate", "rmse_m");
     EXPECT_GE(ate, 0.0);
@@ -64,9 +68,14 @@ class FrontendRendered : public ::testing::Test {
 
 std::string FrontendRendered::dir_;
 
-TEST_F(FrontendRendered, Klt) { ExpectAteBelow("klt", 0.1); }
+// The rendered dataset has images and no features0: without a --frontend
+// flag the run takes the KLT front end and says so.
+TEST_F(FrontendRendered, KltByDefaultOnImagesOnly) {
+  ExpectAteBelow("klt", "", 0.1);
+  EXPECT_NE(ReadFile(dir_ + "/klt.log").find("running the klt front end on the images"), std::string::npos);
+}
 
-TEST_F(FrontendRendered, Brisk) { ExpectAteBelow("brisk", 0.1); }
+TEST_F(FrontendRendered, Brisk) { ExpectAteBelow("brisk", "--frontend=brisk", 0.1); }
 
 }  // namespace
 }  // namespace vio
