@@ -75,6 +75,34 @@ TEST_F(FrontendRendered, KltByDefaultOnImagesOnly) {
   EXPECT_NE(ReadFile(dir_ + "/klt.log").find("running the klt front end on the images"), std::string::npos);
 }
 
+// The rendered folder as a ROS bag (`vio convert`) gives the KLT run the same
+// trajectory (image runs agree to the last digits, not bit for bit).
+TEST_F(FrontendRendered, BagGivesTheFolderTrajectory) {
+  const std::string bag = dir_ + "/data.bag";
+  ASSERT_EQ(RunVio("convert --input=" + dir_ + "/data --output=" + bag, dir_ + "/convert.log"), 0);
+  ASSERT_EQ(RunVio("run --dataset=" + bag + " --calibration=" + dir_ + "/data --output_dir=" + dir_ +
+                       "/bag_run --frontend=klt --policy=swf --window_size=10",
+                   dir_ + "/bag_run.log"),
+            0)
+      << "see " << dir_ << "/bag_run.log";
+  ASSERT_EQ(RunVio("run --dataset=" + dir_ + "/data --output_dir=" + dir_ +
+                       "/folder_run --frontend=klt --policy=swf --window_size=10",
+                   dir_ + "/folder_run.log"),
+            0);
+  std::istringstream a(ReadFile(dir_ + "/bag_run/trajectory.txt")), b(ReadFile(dir_ + "/folder_run/trajectory.txt"));
+  std::string line_a, line_b;
+  int rows = 0;
+  while (std::getline(a, line_a) && std::getline(b, line_b)) {
+    if (line_a.empty() || line_a[0] == '#') continue;
+    std::istringstream ra(line_a), rb(line_b);
+    double va = 0, vb = 0;
+    for (int column = 0; column < 8 && (ra >> va) && (rb >> vb); ++column) EXPECT_NEAR(va, vb, 1e-6) << line_a;
+    ++rows;
+  }
+  EXPECT_GT(rows, 100);
+  EXPECT_FALSE(std::getline(b, line_b)) << "the folder run has more rows";
+}
+
 TEST_F(FrontendRendered, Brisk) { ExpectAteBelow("brisk", "--frontend=brisk", 0.1); }
 
 }  // namespace

@@ -78,7 +78,8 @@ INSTANTIATE_TEST_SUITE_P(Policies, EveryPolicy,
                          [](const auto& info) { return info.param.first; });
 
 // Dropped frames and a blackout longer than the window: every policy
-// propagates through it on the IMU, counts it and regains tracking.
+// propagates through it on the IMU, counts it and regains tracking (iekf is
+// ekf with more iterations: left out, it takes a minute and a half here).
 class EveryPolicyThroughGaps : public ::testing::TestWithParam<std::pair<std::string, double>> {};
 
 TEST_P(EveryPolicyThroughGaps, SurvivesDroppedFramesAndABlackout) {
@@ -106,8 +107,7 @@ TEST_P(EveryPolicyThroughGaps, SurvivesDroppedFramesAndABlackout) {
 INSTANTIATE_TEST_SUITE_P(Policies, EveryPolicyThroughGaps,
                          ::testing::Values(std::make_pair("swf", 0.1), std::make_pair("msckf", 0.1),
                                            std::make_pair("fixed_lag", 0.1), std::make_pair("keyframe", 0.1),
-                                           std::make_pair("ekf", 0.1), std::make_pair("iekf", 0.1),
-                                           std::make_pair("batch", 0.1)),
+                                           std::make_pair("ekf", 0.1), std::make_pair("batch", 0.1)),
                          [](const auto& info) { return info.param.first; });
 
 // The MSCKF's other use of tracks seen from leaving states (whole tracks,
