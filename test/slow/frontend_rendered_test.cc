@@ -54,7 +54,7 @@ class FrontendRendered : public ::testing::Test {
         << "see " << out << ".log";
     const std::string summary = ReadFile(out + "/summary.json");
     EXPECT_NE(summary.find("\"source\": \"" + frontend + "\""), std::string::npos) << summary;
-    EXPECT_NE(ReadFile(out + "/config.yaml").find("frontend: " + frontend), std::string::npos);
+    EXPECT_NE(ReadFile(out + "/config.yaml").find("frontend: \"" + frontend + "\""), std::string::npos);
     EXPECT_NE(summary.find("\"status\": \"ok\""), std::string::npos) << summary;
     const double ate = JsonNumber(summary, "ate", "rmse_m");
     EXPECT_GE(ate, 0.0);
