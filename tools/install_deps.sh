@@ -9,6 +9,7 @@ PACKAGES=(
   libceres-dev libeigen3-dev libopencv-dev
   libgoogle-glog-dev libgflags-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  librosbag-storage-dev libsensor-msgs-dev
   python3 python3-numpy python3-matplotlib
 )
 

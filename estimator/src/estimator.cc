@@ -6,7 +6,11 @@
 
 namespace vio {
 Estimator::Estimator(const EstimatorOptions& options, const ImuCalibration& imu, const RectifiedStereo& stereo)
-    : options_(options), imu_calibration_(imu), window_(options.model, stereo), policy_(MakePolicy(options)) {
+    : options_(options),
+      imu_calibration_(imu),
+      window_(options.model, stereo),
+      policy_(MakePolicy(options)),
+      tracking_(options.policy.min_frame_features, options.policy.window_size) {
   imu_calibration_.gyro_noise_density *= options.model.imu_noise_scale;
   imu_calibration_.accel_noise_density *= options.model.imu_noise_scale;
   imu_calibration_.gyro_random_walk *= options.model.imu_noise_scale;
@@ -34,7 +38,8 @@ FrameEstimate Estimator::ProcessFrame(const StereoFrame& frame) {
     AddPropagatedState(frame.t_ns);
   }
   timing.propagate_ms = MillisecondsSince(start);
-  timing.policy = policy_->Update(GateObservations(frame), last_state_, window_);
+  const bool tracked = tracking_.Observe(frame.t_ns, static_cast<int>(frame.observations.size()));
+  timing.policy = policy_->Update(tracked ? GateObservations(frame) : StereoFrame{frame.t_ns, {}}, last_state_, window_);
   PruneImu(window_.states().begin()->second.t_ns);
   FrameEstimate estimate = Estimate(frame);
   timing.total_ms = MillisecondsSince(start);

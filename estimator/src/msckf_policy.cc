@@ -40,8 +40,8 @@ PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
   timing.build_ms = MillisecondsSince(start);
 
   start = std::chrono::steady_clock::now();
-  const SolveReport report =
-      gn_steps_ ? window.TakeSteps(*gn_steps_, options_.solver) : window.Solve(options_.solver);
+  const std::optional<int> steps = GaussNewtonSteps(frame);
+  const SolveReport report = steps ? window.TakeSteps(*steps, options_.solver) : window.Solve(options_.solver);
   timing.solver_iterations = report.iterations;
   timing.solve_ms = MillisecondsSince(start);
   VLOG(1) << "msckf t=" << frame.t_ns << ": " << added.size() << " landmarks, " << leaving.size()
@@ -52,6 +52,23 @@ PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
   ForgetObservationsOf(leaving);
   timing.marginalize_ms = MillisecondsSince(start);
   return timing;
+}
+
+// Re-anchoring after a tracking loss longer than the window: every state in
+// it is then IMU dead reckoning, and the first updates of the new tracks are
+// linearized far from their solution; for one window of frames they take
+// Gauss-Newton steps to convergence, as the fixed-lag smoother does, instead
+// of gn_steps.
+std::optional<int> MsckfPolicy::GaussNewtonSteps(const StereoFrame& frame) {
+  if (frame.observations.empty()) {
+    ++frames_without_observations_;
+  } else {
+    if (frames_without_observations_ > options_.policy.window_size) reanchor_frames_ = options_.policy.window_size;
+    frames_without_observations_ = 0;
+  }
+  if (reanchor_frames_ == 0 || frame.observations.empty()) return gn_steps_;
+  --reanchor_frames_;
+  return std::nullopt;
 }
 
 // x_i with i mod 3 == 2 (1-based, oldest first) once the window is over

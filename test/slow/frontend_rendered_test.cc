@@ -1,6 +1,7 @@
 // Both image front ends end to end on a short synthetic sequence rendered
 // into images (`vio simulate --camera=images`, made in the test's temp dir),
-// then `vio run` with SWF(10): the run completes and the ATE stays small.
+// then `vio run` with SWF(10): the run completes and the ATE stays small; the
+// KLT run is the default one for a dataset with images and no features0.
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -43,14 +44,17 @@ class FrontendRendered : public ::testing::Test {
         << "see " << dir_ << "/simulate.log";
   }
 
-  static void ExpectAteBelow(const std::string& frontend, double bound_m) {
+  // `vio run` with `flags`; the front end that ran must be `frontend`.
+  static void ExpectAteBelow(const std::string& frontend, const std::string& flags, double bound_m) {
     const std::string out = dir_ + "/" + frontend;
-    ASSERT_EQ(RunVio("run --dataset=" + dir_ + "/data --output_dir=" + out + " --frontend=" + frontend +
+    ASSERT_EQ(RunVio("run --dataset=" + dir_ + "/data --output_dir=" + out + " " + flags +
                       " --policy=swf --window_size=10",
                   out + ".log"),
               0)
         << "see " << out << ".log";
     const std::string summary = ReadFile(out + "/summary.json");
+    EXPECT_NE(summary.find("\"source\": \"" + frontend + "\""), std::string::npos) << summary;
+    EXPECT_NE(ReadFile(out + "/config.yaml").find("frontend: \"" + frontend + "\""), std::string::npos);
     EXPECT_NE(summary.find("\"status\": \"ok\""), std::string::npos) << summary;
     const double ate = JsonNumber(summary, "ate", "rmse_m");
     EXPECT_GE(ate, 0.0);
@@ -64,9 +68,42 @@ class FrontendRendered : public ::testing::Test {
 
 std::string FrontendRendered::dir_;
 
-TEST_F(FrontendRendered, Klt) { ExpectAteBelow("klt", 0.1); }
+// The rendered dataset has images and no features0: without a --frontend
+// flag the run takes the KLT front end and says so.
+TEST_F(FrontendRendered, KltByDefaultOnImagesOnly) {
+  ExpectAteBelow("klt", "", 0.1);
+  EXPECT_NE(ReadFile(dir_ + "/klt.log").find("running the klt front end on the images"), std::string::npos);
+}
 
-TEST_F(FrontendRendered, Brisk) { ExpectAteBelow("brisk", 0.1); }
+// The rendered folder as a ROS bag (`vio convert`) gives the KLT run the same
+// trajectory (image runs agree to the last digits, not bit for bit).
+TEST_F(FrontendRendered, BagGivesTheFolderTrajectory) {
+  const std::string bag = dir_ + "/data.bag";
+  ASSERT_EQ(RunVio("convert --input=" + dir_ + "/data --output=" + bag, dir_ + "/convert.log"), 0);
+  ASSERT_EQ(RunVio("run --dataset=" + bag + " --calibration=" + dir_ + "/data --output_dir=" + dir_ +
+                       "/bag_run --frontend=klt --policy=swf --window_size=10",
+                   dir_ + "/bag_run.log"),
+            0)
+      << "see " << dir_ << "/bag_run.log";
+  ASSERT_EQ(RunVio("run --dataset=" + dir_ + "/data --output_dir=" + dir_ +
+                       "/folder_run --frontend=klt --policy=swf --window_size=10",
+                   dir_ + "/folder_run.log"),
+            0);
+  std::istringstream a(ReadFile(dir_ + "/bag_run/trajectory.txt")), b(ReadFile(dir_ + "/folder_run/trajectory.txt"));
+  std::string line_a, line_b;
+  int rows = 0;
+  while (std::getline(a, line_a) && std::getline(b, line_b)) {
+    if (line_a.empty() || line_a[0] == '#') continue;
+    std::istringstream ra(line_a), rb(line_b);
+    double va = 0, vb = 0;
+    for (int column = 0; column < 8 && (ra >> va) && (rb >> vb); ++column) EXPECT_NEAR(va, vb, 1e-6) << line_a;
+    ++rows;
+  }
+  EXPECT_GT(rows, 100);
+  EXPECT_FALSE(std::getline(b, line_b)) << "the folder run has more rows";
+}
+
+TEST_F(FrontendRendered, Brisk) { ExpectAteBelow("brisk", "--frontend=brisk", 0.1); }
 
 }  // namespace
 }  // namespace vio

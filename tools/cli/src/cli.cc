@@ -79,6 +79,9 @@ const std::vector<Subcommand>& Subcommands() {
        "vio sweep --datasets=DIR,... --policies=swf,... --window_sizes=5,10,... --output_dir=DIR [--jobs=N] "
        "[--config=FILE] [--extra_flags=\"--init=groundtruth ...\"] [--emit_jobs | --collect_only]",
        &SweepMain, /*takes_run_config=*/true},
+      {"convert", "an ASL folder with images to a ROS 1 bag, or a bag to an ASL folder",
+       "vio convert --input=DIR_OR_BAG --output=BAG_OR_DIR [--calibration=DIR] [--cam0_topic=/cam0/image_raw ...]",
+       &ConvertMain, /*takes_run_config=*/true},
   };
   return commands;
 }

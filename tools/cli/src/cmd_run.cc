@@ -6,7 +6,7 @@
 #include "commands.h"
 #include "vio/cli/run.h"
 
-DEFINE_string(dataset, "", "EuRoC ASL dataset folder (holding mav0/) with features0/data.csv");
+DEFINE_string(dataset, "", "EuRoC ASL dataset folder (holding mav0/) with features0/data.csv or images");
 DEFINE_string(config, "", "run configuration YAML (e.g. config/euroc_stereo.yaml); flags override it");
 
 namespace vio::tools {

@@ -34,6 +34,10 @@ DEFINE_double(max_rotation_rate, 1.5, "synthetic flight angular rate limit [rad/
 DEFINE_double(sim_imu_noise, 1.0, "synthetic IMU noise and bias random walk, times the EuRoC densities");
 DEFINE_double(image_noise, 1.0, "rendered image noise, standard deviation [grey levels]");
 DEFINE_int32(png_compression, 1, "PNG compression level of rendered images, 0..9");
+DEFINE_double(drop_frames, 0.0, "fraction of the camera frames removed, in gaps of --drop_gap_frames [0, 1)");
+DEFINE_int32(drop_gap_frames, 1, "consecutive frames removed per gap (1 at 20 Hz: 100 ms gaps)");
+DEFINE_string(blackouts, "", "spans with nothing to track, START:DURATION[,...] in s after the first frame: "
+              "no features, black images");
 
 namespace vio::tools {
 namespace {
@@ -87,6 +91,9 @@ SimulatorOptions OptionsFromFlags() {
   options.imu.noise_scale = FLAGS_sim_imu_noise;
   options.render.image_noise_sigma = FLAGS_image_noise;
   options.png_compression = FLAGS_png_compression;
+  options.gaps.drop_fraction = FLAGS_drop_frames;
+  options.gaps.gap_frames = FLAGS_drop_gap_frames;
+  options.gaps.blackouts = ParseBlackouts("blackouts", FLAGS_blackouts);
   return options;
 }
 

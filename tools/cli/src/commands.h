@@ -16,5 +16,6 @@ int SimulateMain(const std::vector<std::string>& args);
 int EvalMain(const std::vector<std::string>& args);
 int VerifyMain(const std::vector<std::string>& args);
 int SweepMain(const std::vector<std::string>& args);
+int ConvertMain(const std::vector<std::string>& args);
 
 }  // namespace vio::tools

@@ -2,6 +2,7 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -17,27 +18,27 @@
 #include "vio/cli/progress.h"
 #include "vio/dataset/frame_source.h"
 #include "vio/dataset/groundtruth_init.h"
+#include "vio/dataset/rosbag_dataset.h"
 
 namespace vio::tools {
 namespace {
 
-// The dataset's calibration, or the one of the folder the config names.
-void ApplyCalibrationSource(const CalibrationOptions& options, EurocDataset* dataset) {
-  if (options.calibration.empty()) return;
-  EurocReadOptions calibration_only;
-  calibration_only.read_imu = calibration_only.read_groundtruth = calibration_only.read_features = false;
-  calibration_only.check_images = false;
-  const EurocDataset calibration = ReadEuroc(options.calibration, calibration_only);
-  dataset->cameras[0] = calibration.cameras[0];
-  dataset->cameras[1] = calibration.cameras[1];
-  dataset->imu_calibration = calibration.imu_calibration;
-}
-
 EurocDataset ReadRunDataset(const RunRequest& request) {
+  if (IsBagPath(request.dataset_dir)) {
+    if (request.config.calibration.calibration.empty()) {
+      throw std::runtime_error(request.dataset_dir + ": a ROS bag carries no calibration: give --calibration=DIR "
+                               "(a folder with mav0/{cam0,cam1,imu0}/sensor.yaml)");
+    }
+    EurocDataset dataset = ReadBag(request.dataset_dir, request.config.bag);
+    ApplyCalibrationFrom(request.config.calibration.calibration, &dataset);
+    return dataset;
+  }
   EurocReadOptions read;
   read.check_images = request.config.frontend.frontend != "features";
   EurocDataset dataset = ReadEuroc(request.dataset_dir, read);
-  ApplyCalibrationSource(request.config.calibration, &dataset);
+  if (!request.config.calibration.calibration.empty()) {
+    ApplyCalibrationFrom(request.config.calibration.calibration, &dataset);
+  }
   return dataset;
 }
 
@@ -127,6 +128,24 @@ void StopAt(size_t k, size_t num_frames, const std::string& status, const std::s
   result->status = status;
   result->problems.push_back(message);
   result->health.frames_after_stop = static_cast<int>(num_frames - k);
+}
+
+// Frame intervals longer than 1.5 median intervals: missing frames.
+void CountFrameGaps(const FrameSource& source, RunResult* result) {
+  std::vector<Timestamp> intervals;
+  for (size_t k = 1; k < source.size(); ++k) intervals.push_back(source.time(k) - source.time(k - 1));
+  if (intervals.empty()) return;
+  std::vector<Timestamp> sorted = intervals;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double gap_ns = 1.5 * static_cast<double>(sorted[sorted.size() / 2]);
+  for (Timestamp dt : intervals) {
+    result->frame_gaps += static_cast<double>(dt) > gap_ns;
+    result->longest_frame_gap_s = std::max(result->longest_frame_gap_s, NanosToSeconds(dt));
+  }
+  if (result->frame_gaps > 0) {
+    LOG(INFO) << result->frame_gaps << " frame gaps (intervals over 1.5 median intervals), longest "
+              << result->longest_frame_gap_s << " s";
+  }
 }
 
 // The frame loop: IMU, (ground-truth start), front end, estimator, output.
@@ -252,9 +271,11 @@ void Evaluate(const EurocDataset& dataset, const RunRequest& request, const RunO
 
 }  // namespace
 
-RunResult RunDataset(const RunRequest& request) {
-  ValidateRunConfig(request.config);
-  const EurocDataset dataset = ReadRunDataset(request);
+RunResult RunDataset(const RunRequest& requested) {
+  ValidateRunConfig(requested.config);
+  const EurocDataset dataset = ReadRunDataset(requested);
+  RunRequest request = requested;
+  request.config.frontend.frontend = ResolveFrontend(requested.config.frontend.frontend, dataset);
   const frontend::StereoRectifier rectifier(dataset.cameras[0], dataset.cameras[1]);
   const std::unique_ptr<FrameSource> source = MakeFrameSource(request.config.frontend, dataset, rectifier);
   if (request.config.estimator.init.init == "groundtruth" && dataset.groundtruth.empty()) {
@@ -267,8 +288,10 @@ RunResult RunDataset(const RunRequest& request) {
   if (source->size() > 0) {
     result.dataset_duration_s = NanosToSeconds(source->time(source->size() - 1) - source->time(0));
   }
+  CountFrameGaps(*source, &result);
   const auto start = std::chrono::steady_clock::now();
   EstimateFrames(request, dataset, *source, estimator, output, &result);
+  result.tracking = estimator.tracking();
   if (result.status == "ok") FinishEstimates(estimator, output, &result);
   ReportFramesOutsideImu(dataset, *source, request.config.estimator.model.max_imu_gap_s, &result);
   result.processing_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

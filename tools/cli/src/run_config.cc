@@ -4,6 +4,7 @@ namespace vio::tools {
 
 void BindRunConfig(RunConfig* config, OptionRegistry* registry) {
   registry->Add("calibration", &config->calibration);
+  registry->Add("bag", &config->bag);
   registry->Add("frontend", &config->frontend);
   registry->Add("policy", &config->estimator.policy);
   registry->Add("msckf", &config->estimator.msckf);

@@ -131,7 +131,11 @@ void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_jso
       << ",\n  \"processing_s\": " << Number(r.processing_s) << ",\n  \"ms_per_frame\": " << Number(r.ms_per_frame)
       << ",\n  \"real_time_factor\": " << Number(r.real_time_factor)
       << ",\n  \"stage_ms_per_frame\": " << StageTimesJson(frames_)
-      << ",\n  \"peak_memory_mb\": " << Number(peak_memory_mb) << ",\n  \"frontend\": " << frontend_json;
+      << ",\n  \"peak_memory_mb\": " << Number(peak_memory_mb) << ",\n  \"frame_gaps\": {\"count\": " << r.frame_gaps
+      << ", \"longest_s\": " << Number(r.longest_frame_gap_s) << "},\n  \"tracking_loss\": {\"untracked_frames\": "
+      << r.tracking.untracked_frames << ", \"losses\": " << r.tracking.losses << ", \"losses_beyond_window\": "
+      << r.tracking.losses_beyond_window << ", \"longest_s\": " << Number(r.tracking.longest_loss_s)
+      << "},\n  \"frontend\": " << frontend_json;
   if (!waiting_reason.empty()) out << ",\n  \"not_initialized_reason\": " << JsonString(waiting_reason);
   if (r.groundtruth_tilt_deg) out << ",\n  \"groundtruth_tilt_deg\": " << Number(*r.groundtruth_tilt_deg);
   if (r.evaluation) {

@@ -124,6 +124,16 @@ EurocDataset ReadEuroc(const std::string& root, const EurocReadOptions& options)
   return dataset;
 }
 
+void ApplyCalibrationFrom(const std::string& folder, EurocDataset* dataset) {
+  EurocReadOptions calibration_only;
+  calibration_only.read_imu = calibration_only.read_groundtruth = calibration_only.read_features = false;
+  calibration_only.check_images = false;
+  const EurocDataset calibration = ReadEuroc(folder, calibration_only);
+  dataset->cameras[0] = calibration.cameras[0];
+  dataset->cameras[1] = calibration.cameras[1];
+  dataset->imu_calibration = ReadImuYaml(FindSequenceFolders(folder).mav0 + "/imu0/sensor.yaml");
+}
+
 void WriteEuroc(const EurocDataset& dataset, const std::string& root) {
   const std::string mav0 = WithoutTrailingSlash(root) + "/mav0";
   WriteImuYaml(dataset.imu_calibration, mav0 + "/imu0/sensor.yaml");

@@ -4,6 +4,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <glog/logging.h>
+
 #include "frame_source_images.h"
 #include "vio/dataset/stereo_frames.h"
 
@@ -46,6 +48,18 @@ class FeaturesSource final : public FrameSource {
 };
 
 }  // namespace
+
+std::string ResolveFrontend(const std::string& frontend, const EurocDataset& dataset) {
+  if (frontend != "auto") return frontend;
+  if (!dataset.features.empty()) return "features";
+  if (dataset.has_images) {
+    LOG(INFO) << dataset.root << ": no mav0/features0/data.csv, running the klt front end on the images "
+              << "(--frontend=features|brisk|klt overrides)";
+    return "klt";
+  }
+  throw std::runtime_error(dataset.root + ": neither mav0/features0/data.csv nor images in mav0/cam0/data/: "
+                           "nothing to track (generate features with `vio simulate --from=" + dataset.root + "`)");
+}
 
 std::unique_ptr<FrameSource> MakeFrameSource(const FrontendOptions& options, const EurocDataset& dataset,
                                              const frontend::StereoRectifier& rectifier) {

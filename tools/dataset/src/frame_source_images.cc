@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <future>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -13,6 +14,7 @@
 
 #include "vio/frontend/stereo_frontend.h"
 #include "vio/frontend/track_drawing.h"
+#include "vio/dataset/rosbag_dataset.h"
 
 namespace vio::tools {
 namespace {
@@ -42,6 +44,11 @@ class ImageFrameSource final : public FrameSource {
         mav0_(dataset.root + "/mav0"),
         debug_dir_(options.debug_images),
         frontend_(frontend::MakeStereoFrontend(options, rectifier)) {
+    for (int i = 0; i < 2; ++i) {
+      filenames_[i].reserve(dataset.frames[i].size());
+      for (const CameraFrame& f : dataset.frames[i]) filenames_[i].push_back(f.filename);
+      if (!dataset.image_bag.empty()) bag_readers_[i].emplace(dataset.image_bag, dataset.image_topics[i]);
+    }
     PairFrames(dataset);
     if (!debug_dir_.empty()) std::filesystem::create_directories(debug_dir_);
   }
@@ -67,19 +74,19 @@ class ImageFrameSource final : public FrameSource {
  private:
   struct Pair {
     Timestamp t_ns;
-    std::string left, right;  ///< file names under camN/data/
+    size_t left, right;  ///< rows of cam0, cam1 data.csv
   };
 
   void PairFrames(const EurocDataset& dataset) {
-    std::map<Timestamp, std::string> right;
-    for (const CameraFrame& f : dataset.frames[1]) right[f.t_ns] = f.filename;
-    for (const CameraFrame& f : dataset.frames[0]) {
-      const auto it = right.find(f.t_ns);
+    std::map<Timestamp, size_t> right;
+    for (size_t k = 0; k < dataset.frames[1].size(); ++k) right[dataset.frames[1][k].t_ns] = k;
+    for (size_t k = 0; k < dataset.frames[0].size(); ++k) {
+      const auto it = right.find(dataset.frames[0][k].t_ns);
       if (it == right.end()) {
         ++unpaired_;
         continue;
       }
-      pairs_.push_back(Pair{f.t_ns, f.filename, it->second});
+      pairs_.push_back(Pair{dataset.frames[0][k].t_ns, k, it->second});
     }
     if (unpaired_ > 0) LOG(WARNING) << mav0_ << ": " << unpaired_ << " cam0 frames have no cam1 image; skipped";
   }
@@ -95,12 +102,14 @@ class ImageFrameSource final : public FrameSource {
     return images;
   }
 
-  std::pair<cv::Mat, cv::Mat> LoadPair(size_t k) const {
+  std::pair<cv::Mat, cv::Mat> LoadPair(size_t k) {
     return {Load(0, pairs_[k].left), Load(1, pairs_[k].right)};
   }
 
-  cv::Mat Load(int camera, const std::string& filename) const {
-    const std::string path = mav0_ + "/cam" + std::to_string(camera) + "/data/" + filename;
+  // The image of one data.csv row: a file under camN/data/, or a bag message.
+  cv::Mat Load(int camera, size_t row) {
+    if (bag_readers_[camera]) return bag_readers_[camera]->Read(row);
+    const std::string path = mav0_ + "/cam" + std::to_string(camera) + "/data/" + filenames_[camera][row];
     cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
     if (image.empty()) throw std::runtime_error(path + ": cannot read the image");
     return image;
@@ -118,6 +127,8 @@ class ImageFrameSource final : public FrameSource {
   std::string debug_dir_;
   std::unique_ptr<frontend::StereoFrontend> frontend_;
   frontend::TrackDrawer drawer_;
+  std::vector<std::string> filenames_[2];
+  std::optional<BagImageReader> bag_readers_[2];  ///< images from a ROS bag: one sequential reader per camera
   std::vector<Pair> pairs_;
   int unpaired_ = 0;
   double load_ms_ = 0;

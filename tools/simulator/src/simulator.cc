@@ -22,6 +22,9 @@ constexpr Timestamp kSyntheticStartNs = 1'600'000'000'000'000'000;
 /// EuRoC references (MH_04's laser-tracker positions reach 2 m/s).
 constexpr double kMaxGroundTruthVelocityMismatch = 5.0;
 
+/// Grey level of a rendered frame during a blackout (a covered lens).
+constexpr int kBlackoutGrey = 4;
+
 Eigen::Isometry3d FromRowMajor(const std::array<double, 12>& m) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   for (int r = 0; r < 3; ++r) {
@@ -116,6 +119,16 @@ void BuildHybridMotion(const SimulatorOptions& options, Simulation* sim) {
   }
 }
 
+// Features seen during a blackout are removed (and their per-frame counts).
+void BlackOutFeatures(const std::vector<Blackout>& blackouts, Timestamp first_frame_ns, Simulation* sim) {
+  ApplyBlackouts(blackouts, first_frame_ns, &sim->features.observations);
+  for (std::size_t i = 0; i < sim->frames.size() && i < sim->features.cam0_count.size(); ++i) {
+    if (BlackoutAt(sim->frames[i].t_ns, first_frame_ns, blackouts) < 0) continue;
+    sim->features.cam0_count[i] = 0;
+    sim->features.stereo_count[i] = 0;
+  }
+}
+
 SimulationSummary Summarize(const Simulation& sim, const SimulatorOptions& options) {
   SimulationSummary summary;
   summary.hybrid = !options.from_euroc_dir.empty();
@@ -146,6 +159,9 @@ void WriteImages(const Simulation& sim, const SimulatorOptions& options, const R
     std::filesystem::create_directories(folder);
     for (std::size_t i = 0; i < sim.frames.size(); ++i) {
       renderer.Render(sim.frames[i].T_w_b * camera.T_b_c, options.seed * 1'000'003ULL + 2 * i + k, &image);
+      if (BlackoutAt(sim.frames[i].t_ns, sim.frames.front().t_ns, options.gaps.blackouts) >= 0) {
+        image.setTo(cv::Scalar::all(kBlackoutGrey));
+      }
       const std::string path = folder + "/" + sim.dataset.frames[k][i].filename;
       if (!cv::imwrite(path, image, png)) throw std::runtime_error("simulator: cannot write image " + path);
       if (progress) progress(static_cast<std::int64_t>(k * sim.frames.size() + i + 1), total);
@@ -179,12 +195,16 @@ Simulation BuildSimulation(const SimulatorOptions& options) {
   } else {
     BuildHybridMotion(options, &sim);
   }
+  const Timestamp first_frame_ns = sim.frames.empty() ? 0 : sim.frames.front().t_ns;
+  std::mt19937_64 gap_rng(options.seed ^ 0x6761707300000000ULL);  // own stream: other draws do not move
+  sim.frames = DropFrames(sim.frames, options.gaps, &gap_rng);
   sim.dataset.frames[0] = FrameRows(sim.frames);
   sim.dataset.frames[1] = sim.dataset.frames[0];
   sim.scene = BuildScene(options.scene, PathOf(sim.dataset.groundtruth), &rng);
   if (options.camera_output == SimCameraOutput::kFeatures) {
     sim.features = SimulateFeatures(sim.scene, {sim.dataset.cameras[0], sim.dataset.cameras[1]}, sim.frames,
                                     options.features, &rng);
+    BlackOutFeatures(options.gaps.blackouts, first_frame_ns, &sim);
     sim.dataset.features = sim.features.observations;
   }
   return sim;

@@ -11,6 +11,7 @@
 #include "vio/estimator/estimator_options.h"
 #include "vio/estimator/initializer.h"
 #include "vio/estimator/policy.h"
+#include "vio/estimator/tracking_monitor.h"
 #include "vio/estimator/window.h"
 
 namespace vio {
@@ -59,6 +60,8 @@ class Estimator {
   std::optional<Eigen::Isometry3d> PredictBodyPose(Timestamp t_ns) const;
 
   const Window& window() const { return window_; }
+  /// Frames lost to too few observations (propagated on the IMU).
+  const TrackingReport& tracking() const { return tracking_.report(); }
   /// Why static initialization has not happened yet (empty once initialized).
   const std::string& waiting_reason() const { return waiting_reason_; }
   /// Observations rejected by the whitened-residual gate (model.max_whitened_residual).
@@ -84,6 +87,7 @@ class Estimator {
   ImuCalibration imu_calibration_;
   Window window_;
   std::unique_ptr<Policy> policy_;
+  TrackingMonitor tracking_;
   std::vector<ImuSample> imu_;
   std::optional<InitialState> given_initial_state_;
   StateId last_state_;

@@ -20,6 +20,9 @@ struct PolicyOptions {
   std::string ekf_landmarks = "keep";
   int keyframe_temporal_window = 3;  ///< keyframe policy: most recent frames always kept [frames]
   double keyframe_overlap = 0.7;     ///< keyframe policy: new keyframe below this shared-landmark fraction []
+  /// Frames with fewer stereo observations are tracking loss: not used,
+  /// propagated on the IMU (tracking_monitor.h) [count].
+  int min_frame_features = 10;
 
   template <class V>
   void Visit(V& v) {
@@ -42,6 +45,10 @@ struct PolicyOptions {
     v("keyframe_overlap", keyframe_overlap,
       "keyframe policy: a frame sharing less than this fraction of its landmarks with the last keyframe "
       "becomes a keyframe []", Between(0, 1));
+    v("min_frame_features", min_frame_features,
+      "frames with fewer stereo observations count as tracking loss: their observations are not used and the "
+      "state is propagated on the IMU, with a warning [count]",
+      AtLeast(0));
   }
 };
 

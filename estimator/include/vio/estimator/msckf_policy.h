@@ -53,11 +53,14 @@ class MsckfPolicy final : public Policy {
                                           const std::vector<StateId>& leaving) const;
   std::vector<LandmarkId> AddTriangulated(const std::vector<TrackUpdate>& updates, Window& window);
   void ForgetObservationsOf(const std::vector<StateId>& leaving);
+  std::optional<int> GaussNewtonSteps(const StereoFrame& frame);
 
   EstimatorOptions options_;
   std::optional<int> gn_steps_;
   std::map<LandmarkId, std::vector<Observation>> tracks_;  ///< unused observations, oldest first
   MsckfCounts counts_;
+  int frames_without_observations_ = 0;  ///< the current run of empty frames (tracking loss)
+  int reanchor_frames_ = 0;              ///< frames left solving to convergence after a long loss
 };
 
 }  // namespace vio

@@ -8,8 +8,9 @@
 namespace vio {
 
 struct FrontendOptions {
+  /// auto: features0 when the dataset has it, else klt on the images;
   /// features: the dataset's features0/data.csv; brisk / klt: the images.
-  std::string frontend = "features";
+  std::string frontend = "auto";
   /// Stereo pairs whose rectified rows differ by more are rejected [px].
   double max_epipolar_px = 2.0;
   /// Side of the square cells that spread features over the image [px].
@@ -51,9 +52,10 @@ struct FrontendOptions {
   template <class V>
   void Visit(V& v) {
     v("frontend", frontend,
-      "source of stereo observations: features = the dataset's features0/data.csv, brisk = BRISK matching on "
-      "the images (paper 5.2), klt = Lucas-Kanade tracking on the images",
-      {"features", "brisk", "klt"});
+      "source of stereo observations: auto = features0 when the dataset has it, else klt on the images; "
+      "features = the dataset's features0/data.csv, brisk = BRISK matching on the images (paper 5.2), "
+      "klt = Lucas-Kanade tracking on the images",
+      {"auto", "features", "brisk", "klt"});
     v("max_epipolar_px", max_epipolar_px, "reject stereo pairs whose rectified rows differ by more [px]", Positive());
     v("grid_cell_px", grid_cell_px, "side of the grid cells spreading image features [px]", AtLeast(1));
     v("max_reprojection_px", max_reprojection_px,

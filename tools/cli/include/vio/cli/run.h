@@ -5,13 +5,15 @@
 // Output folder:
 //   trajectory.txt  TUM text, body in world: t[s] x y z qx qy qz qw, one row per estimated frame
 //   timing.csv      per frame: stage times [ms], solver iterations, window size
-//   summary.json    counts, time per stage, real-time factor, peak memory, ATE/RPE (when ground truth exists)
+//   summary.json    counts (frame gaps, tracking loss), time per stage, real-time factor, peak memory,
+//                   ATE/RPE (when ground truth exists)
 //   config.yaml     the effective configuration
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "vio/cli/run_config.h"
+#include "vio/estimator/tracking_monitor.h"
 #include "vio/evaluation/trajectory_eval.h"
 
 namespace vio::tools {
@@ -52,6 +54,9 @@ struct RunResult {
   double real_time_factor = 0;   ///< dataset_duration_s / processing_s
   RunHealth health;
   std::optional<double> groundtruth_tilt_deg;  ///< tilt of the ground truth's z from up (decides the alignment)
+  int frame_gaps = 0;             ///< frame intervals longer than 1.5 median intervals (missing frames)
+  double longest_frame_gap_s = 0; ///< longest frame interval [s]
+  TrackingReport tracking;        ///< frames with too few observations (propagated on the IMU)
   std::optional<TrajectoryEvaluation> evaluation;  ///< when ground truth exists
 };
 

@@ -6,6 +6,7 @@
 #include "vio/estimator/estimator_options.h"
 #include "vio/frontend/frontend_options.h"
 #include "vio/cli/options_registry.h"
+#include "vio/dataset/rosbag_dataset.h"
 
 namespace vio::tools {
 
@@ -17,12 +18,14 @@ struct CalibrationOptions {
   template <class V>
   void Visit(V& v) {
     v("calibration", calibration,
-      "folder whose mav0/{cam0,cam1,imu0}/sensor.yaml calibrate the run; empty = the dataset's own");
+      "folder whose mav0/{cam0,cam1,imu0}/sensor.yaml calibrate the run; empty = the dataset's own "
+      "(required for a ROS bag)");
   }
 };
 
 struct RunConfig {
   CalibrationOptions calibration;
+  BagTopics bag;  ///< topics of a ROS bag given as --dataset
   FrontendOptions frontend;
   EstimatorOptions estimator;
 };

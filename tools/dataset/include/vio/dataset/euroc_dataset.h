@@ -73,6 +73,10 @@ struct EurocDataset {
   CameraCalibration cameras[2];
   std::vector<CameraFrame> frames[2];  ///< cam0, cam1 data.csv rows
   bool has_images = false;             ///< images were checked and every listed one exists
+  /// A ROS bag holding the images as messages of `image_topics` (rosbag_dataset.h); empty: the
+  /// images are the files of mav0/camN/data/.
+  std::string image_bag;
+  std::string image_topics[2];
   std::vector<GroundTruthState> groundtruth;
   std::vector<FeatureObservation> features;  ///< features0, sorted by (t, camera, id)
 };
@@ -95,6 +99,10 @@ struct EurocReadOptions {
 /// are stored in `imu_gaps` and LOG(WARNING)ed. Throws DatasetError naming
 /// file and line on bad input.
 EurocDataset ReadEuroc(const std::string& root, const EurocReadOptions& options = {});
+
+/// Replaces the camera and IMU calibration of `dataset` with those of the ASL
+/// folder `folder` (its mav0/{cam0,cam1,imu0}/sensor.yaml and camN/data.csv).
+void ApplyCalibrationFrom(const std::string& folder, EurocDataset* dataset);
 
 /// Writes a whole ASL folder (creates directories): imu0, cam0/cam1 (sensor.yaml,
 /// data.csv; images are the caller's), state_groundtruth_estimate0, body.yaml,

@@ -27,7 +27,13 @@ class FrameSource {
   virtual std::string ReportJson() const = 0;
 };
 
-/// The source `options.frontend` names. Throws
+/// The front end `frontend` (a FrontendOptions::frontend value) stands for on
+/// `dataset`: `auto` is `features` when the dataset has features0, else `klt`
+/// when it has images (logged in one line), else an error; any other value is
+/// itself. Throws std::runtime_error when `auto` finds nothing to track.
+std::string ResolveFrontend(const std::string& frontend, const EurocDataset& dataset);
+
+/// The source `options.frontend` names (resolved: not `auto`). Throws
 /// std::runtime_error when the dataset lacks what it needs.
 std::unique_ptr<FrameSource> MakeFrameSource(const FrontendOptions& options, const EurocDataset& dataset,
                                              const frontend::StereoRectifier& rectifier);

@@ -11,6 +11,7 @@
 //    cam0 stamps; frames outside the ground truth are dropped).
 // The camera side is either feature tracks (features0/data.csv,
 // features.h) or rendered stereo PNG images (cam0/cam1, render.h).
+// Frames can be dropped and blacked out on purpose (gaps.h).
 // Output is deterministic for a given seed.
 #include <array>
 #include <cstdint>
@@ -20,6 +21,7 @@
 
 #include "vio/dataset/euroc_dataset.h"
 #include "vio/simulator/features.h"
+#include "vio/simulator/gaps.h"
 #include "vio/simulator/imu.h"
 #include "vio/simulator/render.h"
 #include "vio/simulator/scene.h"
@@ -51,6 +53,8 @@ struct SimulatorOptions {
   ImuSynthesisOptions imu;
   /// Feature tracks (features mode).
   FeatureSimOptions features;
+  /// Dropped frames and blackouts (none by default).
+  FrameGapOptions gaps;
   /// Image rendering (images mode; texture seed derived from `seed`).
   RenderOptions render;
   /// PNG compression level 0..9 of rendered images (1: fast, larger files).
