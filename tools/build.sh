@@ -1,9 +1,45 @@
 #!/usr/bin/env bash
-# Configures and builds the project (Release) into build/. Used by demo.sh and
-# test.sh; BUILD_DIR overrides the folder, JOBS the parallelism.
+# Configures and builds the project (Release) into build/. Used by demo.sh,
+# test.sh and the Dockerfile; BUILD_DIR overrides the folder, JOBS the
+# parallelism, CMAKE_ARGS adds configure options.
+#
+# usage: build.sh [--progress] [TARGET...]   (default: every target)
+#   --progress  one line per 10 % of the build instead of the compiler lines;
+#               the whole output is in BUILD_DIR/build.log (printed on failure)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${BUILD_DIR:-$root/build}"
 jobs="${JOBS:-$(nproc)}"
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build" -j "$jobs"
+progress=0
+if [ "${1:-}" = "--progress" ]; then progress=1; shift; fi
+targets=()
+for target in "$@"; do targets+=(--target "$target"); done
+
+read -r -a cmake_args <<< "${CMAKE_ARGS:-}"
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release "${cmake_args[@]}" >/dev/null
+if [ "$progress" -eq 0 ]; then
+  exec cmake --build "$build" -j "$jobs" "${targets[@]}"
+fi
+
+# Ninja's status line is "@@finished/total@@ what"; print it every 10 %.
+log="$build/build.log"
+report() {
+  local last=-10 finished total percent steps=0
+  while IFS= read -r line; do
+    echo "$line" >> "$log"
+    [[ "$line" =~ ^@@([0-9]+)/([0-9]+)@@ ]] || continue
+    finished=${BASH_REMATCH[1]} total=${BASH_REMATCH[2]} steps=1
+    percent=$((100 * finished / total))
+    if [ "$percent" -ge $((last + 10)) ] || [ "$finished" -eq "$total" ]; then
+      last=$percent
+      echo "build: ${percent}% (${finished}/${total} steps)"
+    fi
+  done
+  [ "$steps" -eq 1 ] || echo "build: up to date"
+}
+: > "$log"
+if ! NINJA_STATUS="@@%f/%t@@ " cmake --build "$build" -j "$jobs" "${targets[@]}" 2>&1 | report; then
+  echo "build: FAILED; the last lines of $log:" >&2
+  tail -n 40 "$log" >&2
+  exit 1
+fi

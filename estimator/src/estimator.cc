@@ -51,7 +51,10 @@ bool Estimator::Initialize(const StereoFrame& frame) {
   }
   const StaticInitResult result = InitializeStatic(imu_, frame.t_ns, options_.init);
   if (!result.state) {
-    if (result.reason != waiting_reason_) LOG(WARNING) << "waiting for static initialization: " << result.reason;
+    if (result.moving && !waiting_while_moving_) {
+      LOG(WARNING) << "waiting for static initialization: " << result.reason << "; waiting until it is still";
+    }
+    waiting_while_moving_ = result.moving;
     waiting_reason_ = result.reason;
     return false;
   }

@@ -86,6 +86,7 @@ class Estimator {
   StateId last_state_;
   std::int64_t next_state_id_ = 0;
   std::string waiting_reason_;
+  bool waiting_while_moving_ = false;  ///< the IMU moved at the last frame before initialization
 };
 
 }  // namespace vio
