@@ -16,6 +16,7 @@ targets=()
 for target in "$@"; do targets+=(--target "$target"); done
 
 read -r -a cmake_args <<< "${CMAKE_ARGS:-}"
+[ "$progress" -eq 1 ] && echo "build: configuring with CMake (Release, Ninja) in $build"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release "${cmake_args[@]}" >/dev/null
 if [ "$progress" -eq 0 ]; then
   exec cmake --build "$build" -j "$jobs" "${targets[@]}"
@@ -24,22 +25,23 @@ fi
 # Ninja's status line is "@@finished/total@@ what"; print it every 10 %.
 log="$build/build.log"
 report() {
-  local last=-10 finished total percent steps=0
+  local last=0 finished total percent
   while IFS= read -r line; do
     echo "$line" >> "$log"
     [[ "$line" =~ ^@@([0-9]+)/([0-9]+)@@ ]] || continue
-    finished=${BASH_REMATCH[1]} total=${BASH_REMATCH[2]} steps=1
+    finished=${BASH_REMATCH[1]} total=${BASH_REMATCH[2]}
     percent=$((100 * finished / total))
-    if [ "$percent" -ge $((last + 10)) ] || [ "$finished" -eq "$total" ]; then
+    if [ "$finished" -gt 0 ] && { [ "$percent" -ge $((last + 10)) ] || [ "$finished" -eq "$total" ]; }; then
       last=$percent
       echo "build: ${percent}% (${finished}/${total} steps)"
     fi
   done
-  [ "$steps" -eq 1 ] || echo "build: up to date"
 }
+started=$SECONDS
 : > "$log"
 if ! NINJA_STATUS="@@%f/%t@@ " cmake --build "$build" -j "$jobs" "${targets[@]}" 2>&1 | report; then
   echo "build: FAILED; the last lines of $log:" >&2
   tail -n 40 "$log" >&2
   exit 1
 fi
+echo "build: done in $((SECONDS - started)) s (${*:-every target}; log: $log)"

@@ -20,16 +20,16 @@ step 1 "installing the Debian packages that are missing (nothing when all are th
 step 2 "building vio (Release, only what the demo needs)"
 "$root/tools/build.sh" --progress vio
 
-step 3 "simulating a 30 s flight through a room: $out/dataset"
-rm -rf "$out/dataset" "$out/run" "$out/sweep"
+step 3 "simulating a 30 s flight through a room: $out/synthetic_30s"
+rm -rf "$out/synthetic_30s" "$out/run" "$out/sweep"
 mkdir -p "$out"
-"$vio" simulate --output_dir="$out/dataset" --duration_s=30 --seed=1
+"$vio" simulate --output_dir="$out/synthetic_30s" --duration_s=30 --seed=1
 
 step 4 "running the estimator (sliding window filter, 10 states): $out/run"
-"$vio" run --dataset="$out/dataset" --config="$config" --output_dir="$out/run" > "$out/run.log"
+"$vio" run --dataset="$out/synthetic_30s" --config="$config" --output_dir="$out/run" > "$out/run.log"
 
 step 5 "comparing SWF(5), SWF(10) and MSCKF(10) with vio sweep: $out/sweep"
-"$vio" sweep --datasets="$out/dataset" --runs=swf:5,swf:10,msckf:10 --jobs=2 --config="$config" \
+"$vio" sweep --datasets="$out/synthetic_30s" --runs=swf:5,swf:10,msckf:10 --jobs=2 --config="$config" \
   --output_dir="$out/sweep"
 
 /usr/bin/python3 - "$out" "$root" $((SECONDS - started)) <<'EOF'
@@ -50,7 +50,7 @@ vio = rel(os.path.join(root, "build", "bin", "vio"))
 data = rel(os.path.join(root, "..", "shared", "data", "euroc", "V2_01_easy"))
 print("next:")
 print(f"  {vio} --help                                  every command; {vio} run --help: every flag")
-print(f"  {vio} run --dataset={rel(os.path.join(out, 'dataset'))} --output_dir=out/msckf --policy=msckf")
+print(f"  {vio} run --dataset={rel(os.path.join(out, 'synthetic_30s'))} --output_dir=out/msckf --policy=msckf")
 print(f"  {vio} simulate --from={data} --output_dir=out/hybrid   a real EuRoC flight, simulated camera")
 print(f"  {vio} verify                                  the paper's filter = optimization theorems")
 print("  tools/test.sh                                      build everything and run the test suite")

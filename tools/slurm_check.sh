@@ -115,16 +115,20 @@ fi
 say "node $host idle"
 
 runs=swf:5,msckf:5,swf:10
-"$vio" simulate --output_dir="$tmp/data" --duration_s=12 --seed=3 > "$tmp/simulate.log"
+"$vio" simulate --output_dir="$tmp/data" --duration_s=12 --seed=3 > "$tmp/simulate.log" 2>&1 ||
+  fail "vio simulate: $(tail -n 5 "$tmp/simulate.log")"
 sweep() { "$vio" sweep --datasets="$tmp/data" --runs="$runs" "$@"; }
 
 sweep --output_dir="$tmp/slurm" --emit_jobs > "$tmp/emit.log"
 lines="$(wc -l < "$tmp/slurm/jobs.txt")"
 say "submitting $lines array tasks: sbatch --array=1-$lines --wait"
-sbatch --parsable --wait --array="1-$lines" --output="$tmp/log/task_%a.out" --chdir="$tmp" \
+timeout 600 sbatch --parsable --wait --array="1-$lines" --output="$tmp/log/task_%a.out" --chdir="$tmp" \
   --wrap="sed -n \"\${SLURM_ARRAY_TASK_ID}p\" $tmp/slurm/jobs.txt | bash" > "$tmp/sbatch.log" 2>&1 ||
   fail "the job array failed: $(cat "$tmp/sbatch.log"; tail -n 5 "$tmp"/log/task_*.out)"
-say "job $(head -n 1 "$tmp/sbatch.log") finished"
+job="$(head -n 1 "$tmp/sbatch.log")"
+ran="$(grep -c "_job_complete: JobId=${job}_[0-9]*([0-9]*) WEXITSTATUS 0" "$tmp/log/slurmctld.log" || true)"
+[ "$ran" -eq "$lines" ] || fail "slurmctld completed $ran of the $lines array tasks with exit 0 (log: $tmp/log)"
+say "job $job: slurmctld ran the $lines array tasks, each with exit 0"
 sweep --output_dir="$tmp/slurm" --collect_only > "$tmp/collect.log" ||
   fail "collecting the Slurm sweep: $(tail -n 5 "$tmp/collect.log")"
 sweep --output_dir="$tmp/local" --jobs=2 > "$tmp/local.log" || fail "the local sweep: $(tail -n 5 "$tmp/local.log")"

@@ -1,6 +1,7 @@
 #include "vio/estimator/estimator.h"
 
 #include <chrono>
+#include <iomanip>
 
 #include <glog/logging.h>
 
@@ -58,7 +59,8 @@ bool Estimator::Initialize(const StereoFrame& frame) {
     waiting_reason_ = result.reason;
     return false;
   }
-  LOG(INFO) << "static initialization at t=" << NanosToSeconds(frame.t_ns) << " s";
+  LOG(INFO) << "static initialization at t=" << std::fixed << std::setprecision(3) << NanosToSeconds(frame.t_ns)
+            << " s";
   AddFirstState(*result.state);
   return true;
 }
