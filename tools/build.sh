@@ -4,7 +4,8 @@
 # parallelism, CMAKE_ARGS adds configure options.
 #
 # usage: build.sh [--progress] [TARGET...]   (default: every target)
-#   --progress  one line per 10 % of the build instead of the compiler lines;
+#   --progress  a line per 10 % of the build, and for each step that starts
+#               30 s or more after the last line, instead of the compiler lines;
 #               the whole output is in BUILD_DIR/build.log (printed on failure)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -25,15 +26,16 @@ fi
 # Ninja's status line is "@@finished/total@@ what"; print it every 10 %.
 log="$build/build.log"
 report() {
-  local last=0 finished total percent
+  local last=0 last_time=$SECONDS finished total percent
   while IFS= read -r line; do
     echo "$line" >> "$log"
     [[ "$line" =~ ^@@([0-9]+)/([0-9]+)@@ ]] || continue
     finished=${BASH_REMATCH[1]} total=${BASH_REMATCH[2]}
     percent=$((100 * finished / total))
-    if [ "$finished" -gt 0 ] && { [ "$percent" -ge $((last + 10)) ] || [ "$finished" -eq "$total" ]; }; then
-      last=$percent
-      echo "build: ${percent}% (${finished}/${total} steps)"
+    if [ "$finished" -gt 0 ] && { [ "$percent" -ge $((last + 10)) ] || [ "$finished" -eq "$total" ] ||
+                                  [ $((SECONDS - last_time)) -ge 30 ]; }; then
+      last=$percent last_time=$SECONDS
+      echo "build: ${percent}% (${finished}/${total} steps, $((SECONDS - started)) s)"
     fi
   done
 }

@@ -68,10 +68,15 @@ void PrintCommandHelp(const Subcommand& cmd, std::ostream& os) {
       if (f.filename.rfind("options/", 0) == 0) PrintFlag(f, os);
     }
   }
-  os << "\nlogging (glog; every command):\n";
-  for (const char* name : {"v", "minloglevel"}) {
+  os << "\nlogging (glog, to stderr; every command):\n";
+  const std::pair<const char*, const char*> logging[] = {
+      {"v", "verbose logging: also show VLOG(m) messages for m <= this"},
+      {"minloglevel", "show only messages at this level or above: 0 INFO, 1 WARNING, 2 ERROR"}};
+  for (const auto& [name, description] : logging) {
     gflags::CommandLineFlagInfo f;
-    if (gflags::GetCommandLineFlagInfo(name, &f)) PrintFlag(f, os);
+    if (!gflags::GetCommandLineFlagInfo(name, &f)) continue;
+    f.description = description;
+    PrintFlag(f, os);
   }
 }
 
