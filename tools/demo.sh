@@ -32,12 +32,15 @@ step 5 "comparing SWF(5), SWF(10) and MSCKF(10) with vio sweep: $out/sweep"
 "$vio" sweep --datasets="$out/synthetic_30s" --runs=swf:5,swf:10,msckf:10 --jobs=2 --config="$config" \
   --output_dir="$out/sweep"
 
-/usr/bin/python3 - "$out" "$root" $((SECONDS - started)) <<'EOF'
+/usr/bin/python3 - "$out" "$root" $((SECONDS - started)) "$vio" <<'EOF'
 import json, os, sys
-out, root, seconds = sys.argv[1], sys.argv[2], int(sys.argv[3])
+out, root, seconds, vio_path = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
 s = json.load(open(os.path.join(out, "run", "summary.json")))
 ate = s.get("evaluation", {}).get("ate", {}).get("rmse_m")
-rel = lambda p: os.path.relpath(p, os.getcwd())
+def rel(path):
+    """`path` relative to the current folder, or absolute when that is shorter to read."""
+    relative = os.path.relpath(path, os.getcwd())
+    return os.path.abspath(path) if relative.startswith("../..") else relative
 print(f"\n== done in {seconds // 60} min {seconds % 60} s")
 ate_text = f"ATE {ate:.3f} m (after position + yaw alignment)" if ate is not None else "no ATE (no ground truth)"
 print(f"SWF(10) on the simulated flight: {s['status']}, {s['frames_estimated']}/{s['frames']} frames, {ate_text},"
@@ -46,12 +49,16 @@ print(f"  run files      {rel(os.path.join(out, 'run'))}/: trajectory.txt summar
 print(f"  comparison     {rel(os.path.join(out, 'sweep', 'report.md'))} (table and plots),"
       f" {rel(os.path.join(out, 'sweep', 'results.csv'))}")
 print(f"  plots          {rel(os.path.join(out, 'sweep', 'plots'))}/*.png")
-vio = rel(os.path.join(root, "build", "bin", "vio"))
+vio = rel(vio_path)
 data = rel(os.path.join(root, "..", "shared", "data", "euroc", "V2_01_easy"))
 print("next:")
-print(f"  {vio} --help                                  every command; {vio} run --help: every flag")
-print(f"  {vio} run --dataset={rel(os.path.join(out, 'synthetic_30s'))} --output_dir=out/msckf --policy=msckf")
-print(f"  {vio} simulate --from={data} --output_dir=out/hybrid   a real EuRoC flight, simulated camera")
-print(f"  {vio} verify                                  the paper's filter = optimization theorems")
-print("  tools/test.sh                                      build everything and run the test suite")
+for command, what in [
+    (f"{vio} --help", "the commands; `vio run --help`: every flag of a run"),
+    (f"{vio} run --dataset={rel(os.path.join(out, 'synthetic_30s'))} --output_dir=out/msckf --policy=msckf",
+     "another estimator on the same flight"),
+    (f"{vio} simulate --from={data} --output_dir=out/hybrid", "a real EuRoC flight with a simulated camera"),
+    (f"{vio} verify", "the paper's filter = optimization theorems, checked"),
+    ("tools/test.sh", "build everything and run the test suite"),
+]:
+    print(f"  {command}\n      {what}")
 EOF
