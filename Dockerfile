@@ -23,7 +23,7 @@ RUN rm -rf /src/build \
 RUN py=/usr/lib/python3/dist-packages \
  && /src/tools/docker_runtime_files.sh /runtime /base-libs.txt /usr/local/bin/vio /usr/bin/python3 \
       /usr/lib/python3.11 $py/numpy $py/matplotlib $py/mpl_toolkits $py/PIL $py/kiwisolver $py/dateutil \
-      $py/pyparsing $py/packaging $py/cycler.py $py/six.py /usr/share/matplotlib \
+      $py/pyparsing $py/packaging $py/cycler.py $py/six.py /usr/share/matplotlib /etc/matplotlibrc \
  && install -D -m 755 /src/tools/plot_sweep.py /runtime/usr/local/share/vio/plot_sweep.py \
  && mkdir -p /runtime/opt/vio && cp -r /src/config /runtime/opt/vio/config
 
