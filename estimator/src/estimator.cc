@@ -1,6 +1,7 @@
 #include "vio/estimator/estimator.h"
 
 #include <chrono>
+#include <iomanip>
 
 #include <glog/logging.h>
 
@@ -56,11 +57,15 @@ bool Estimator::Initialize(const StereoFrame& frame) {
   }
   const StaticInitResult result = InitializeStatic(imu_, frame.t_ns, options_.init);
   if (!result.state) {
-    if (result.reason != waiting_reason_) LOG(WARNING) << "waiting for static initialization: " << result.reason;
+    if (result.moving && !waiting_while_moving_) {
+      LOG(WARNING) << "waiting for static initialization: " << result.reason << "; waiting until it is still";
+    }
+    waiting_while_moving_ = result.moving;
     waiting_reason_ = result.reason;
     return false;
   }
-  LOG(INFO) << "static initialization at t=" << NanosToSeconds(frame.t_ns) << " s";
+  LOG(INFO) << "static initialization at t=" << std::fixed << std::setprecision(3) << NanosToSeconds(frame.t_ns)
+            << " s";
   AddFirstState(*result.state);
   return true;
 }

@@ -62,7 +62,7 @@ StaticInitResult InitializeStatic(const std::vector<ImuSample>& imu, Timestamp t
     why << "the IMU is moving at t=" << NanosToSeconds(t_ns) << " s (gyro std " << s.gyro_std << " rad/s, limit "
         << options.static_max_gyro_std << "; accel std " << s.accel_std << " m/s^2, limit "
         << options.static_max_accel_std << ")";
-    return {std::nullopt, why.str()};
+    return {std::nullopt, why.str(), /*moving=*/true};
   }
   InitialState state;
   state.t_ns = t_ns;

@@ -55,7 +55,7 @@ TEST(EvalReport, JsonHasEveryFieldAndNullForMissingRpe) {
 TEST(EvalReport, TextNamesTheNumbersAndMarksMissingRpe) {
   const std::string text = ToText(KnownEvaluation());
   EXPECT_THAT(text, HasSubstr("alignment   se3"));
-  EXPECT_THAT(text, HasSubstr("100 compared, 7 skipped"));
+  EXPECT_THAT(text, HasSubstr("100 compared with the ground truth, 7 not (outside its time span"));
   EXPECT_THAT(text, HasSubstr("rmse 0.2500  mean 0.2000  median 0.1250  max 0.7500"));
   EXPECT_THAT(text, HasSubstr("rmse 1.500 deg"));
   EXPECT_THAT(text, HasSubstr("       1.0      2.500       0.3750     90"));

@@ -104,6 +104,12 @@ TEST(SweepEndToEnd, TinySweepWritesOneOkRowPerRunAndPlots) {
   for (const char* png : {"trajectories_synth8.png", "position_error_synth8.png", "ate_vs_cost.png"}) {
     EXPECT_GT(fs::file_size(out + "/plots/" + png), 10000u) << png << "\n" << sweep.output;
   }
+  // The report: the results table, then every plot.
+  const std::string report = ReadFile(out + "/report.md");
+  EXPECT_THAT(report, HasSubstr("| synth8 | swf | 5 | ok |"));
+  for (const char* png : {"trajectories_synth8.png", "position_error_synth8.png", "ate_vs_cost.png"}) {
+    EXPECT_THAT(report, HasSubstr(std::string("](plots/") + png + ")")) << report;
+  }
 }
 
 TEST(SweepEndToEnd, BadPolicyIsAFailedRunReportedByNameAndTheOthersStillRun) {

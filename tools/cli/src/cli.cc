@@ -1,5 +1,8 @@
 #include "vio/cli/cli.h"
 
+#include <algorithm>
+#include <charconv>
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <string>
@@ -26,24 +29,54 @@ void PrintTopLevelHelp(std::ostream& os) {
   os << "\n`vio <command> --help` lists the command's flags.\n";
 }
 
+bool EndsWith(const std::string& text, const std::string& suffix) {
+  return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// A default as written on the command line: doubles in their shortest exact
+// form (gflags writes 0.8 as 0.80000000000000004).
+std::string DefaultText(const gflags::CommandLineFlagInfo& f) {
+  if (f.type != "double") return f.default_value;
+  const double value = std::strtod(f.default_value.c_str(), nullptr);
+  char text[32];
+  const auto [end, ec] = std::to_chars(text, text + sizeof(text), value);
+  return ec == std::errc() ? std::string(text, end) : f.default_value;
+}
+
+void PrintFlag(const gflags::CommandLineFlagInfo& f, std::ostream& os) {
+  os << "  --" << f.name << "=" << DefaultText(f) << " (" << f.type << ")\n      " << f.description << "\n";
+}
+
 // The flags a command takes: those defined in its own source file
-// (cmd_<name>.cc) and every estimator/front-end option (registered from the
-// Options structs, file name "options/<section>").
+// (cmd_<name>.cc), the shared ones it names, every estimator/front-end option
+// (registered from the Options structs, file name "options/<section>") when
+// it takes the run configuration, and glog's verbosity flags.
 void PrintCommandHelp(const Subcommand& cmd, std::ostream& os) {
   os << "vio " << cmd.name << ": " << cmd.summary << "\n\nusage: " << cmd.usage << "\n\nflags:\n";
   std::vector<gflags::CommandLineFlagInfo> flags;
   gflags::GetAllFlags(&flags);
   const std::string own = "cmd_" + cmd.name + ".cc";
-  const std::string shared = "cli.cc";
+  auto shared = [&](const std::string& name) {
+    return std::find(cmd.shared_flags.begin(), cmd.shared_flags.end(), name) != cmd.shared_flags.end();
+  };
   for (const auto& f : flags) {
-    const bool mine = f.filename.size() >= own.size() &&
-                      f.filename.compare(f.filename.size() - own.size(), own.size(), own) == 0;
-    const bool common = f.filename.size() >= shared.size() &&
-                        f.filename.compare(f.filename.size() - shared.size(), shared.size(), shared) == 0;
-    const bool option = f.filename.rfind("options/", 0) == 0;
-    if (!mine && !common && !(option && cmd.takes_run_config)) continue;
-    os << "  --" << f.name << "=" << f.default_value << " (" << f.type << ")\n      " << f.description
-       << "\n";
+    if (EndsWith(f.filename, own) || shared(f.name)) PrintFlag(f, os);
+  }
+  if (cmd.takes_run_config) {
+    os << "\nrun configuration (each also a key of the --config YAML; the flag wins):\n";
+    for (const auto& f : flags) {
+      if (f.filename.rfind("options/", 0) == 0) PrintFlag(f, os);
+    }
+  }
+  os << "\nlogging (glog, to stderr; every command):\n";
+  const std::pair<const char*, const char*> logging[] = {
+      {"v", "verbose logging: also show VLOG(m) messages for m <= this"},
+      {"minloglevel", "show only messages at this level or above: 0 INFO, 1 WARNING, 2 ERROR"}};
+  for (const auto& [name, description] : logging) {
+    gflags::CommandLineFlagInfo f;
+    if (!gflags::GetCommandLineFlagInfo(name, &f)) continue;
+    f.description = description;
+    PrintFlag(f, os);
   }
 }
 
@@ -67,21 +100,22 @@ const std::vector<Subcommand>& Subcommands() {
   static const std::vector<Subcommand> commands = {
       {"run", "run the estimator over one EuRoC-format dataset",
        "vio run --dataset=DIR --output_dir=DIR [--config=FILE] [--policy=swf --window_size=10 ...]", &RunMain,
-       /*takes_run_config=*/true},
+       {"output_dir"}, /*takes_run_config=*/true},
       {"simulate", "generate a synthetic or hybrid EuRoC-format dataset",
-       "vio simulate --output_dir=DIR [--from=EUROC_DIR] [--camera=features|images]", &SimulateMain},
+       "vio simulate --output_dir=DIR [--from=EUROC_DIR] [--camera=features|images] [--seed=N]", &SimulateMain,
+       {"output_dir"}},
       {"eval", "trajectory error (ATE, RPE) of an estimate against ground truth",
        "vio eval --estimate=FILE --groundtruth=FILE_OR_DIR [--alignment=posyaw|se3|sim3|none] [--json=FILE]",
        &EvalMain},
       {"verify", "check the paper's filter = optimization equivalence theorems on random problems",
-       "vio verify [--seed=N] [--num_landmarks=N] [--num_poses=N] [--trials=N]", &VerifyMain},
-      {"sweep", "run every dataset x policy x window size, N at a time; table, CSV and plots",
+       "vio verify [--seed=N] [--num_landmarks=N] [--num_poses=N] [--trials=N]", &VerifyMain, {"seed"}},
+      {"sweep", "run every dataset x policy x window size, N at a time; table, CSV, plots and report",
        "vio sweep --datasets=DIR,... --policies=swf,... --window_sizes=5,10,... --output_dir=DIR [--jobs=N] "
        "[--config=FILE] [--extra_flags=\"--init=groundtruth ...\"] [--emit_jobs | --collect_only]",
-       &SweepMain, /*takes_run_config=*/true},
+       &SweepMain, {"output_dir", "config"}, /*takes_run_config=*/true},
       {"convert", "an ASL folder with images to a ROS 1 bag, or a bag to an ASL folder",
        "vio convert --input=DIR_OR_BAG --output=BAG_OR_DIR [--calibration=DIR] [--cam0_topic=/cam0/image_raw ...]",
-       &ConvertMain, /*takes_run_config=*/true},
+       &ConvertMain, {}, /*takes_run_config=*/true},
   };
   return commands;
 }

@@ -12,8 +12,13 @@ DEFINE_string(config, "", "run configuration YAML (e.g. config/euroc_stereo.yaml
 namespace vio::tools {
 
 int RunMain(const std::vector<std::string>& args) {
-  if (!args.empty() || FLAGS_dataset.empty() || FLAGS_output_dir.empty()) {
-    std::cerr << "vio run: --dataset and --output_dir are required (see `vio run --help`)\n";
+  if (!args.empty()) {
+    std::cerr << "vio run: unexpected argument '" << args.front() << "' (flags are --name=value; see `vio run --help`)\n";
+    return 2;
+  }
+  if (FLAGS_dataset.empty() || FLAGS_output_dir.empty()) {
+    std::cerr << "vio run: " << (FLAGS_dataset.empty() ? "--dataset" : "--output_dir")
+              << " is required (see `vio run --help`)\n";
     return 2;
   }
   RunRequest request;

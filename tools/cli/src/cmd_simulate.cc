@@ -15,8 +15,6 @@
 #include "vio/cli/progress.h"
 #include "vio/simulator/simulator.h"
 
-// --output_dir is shared with `vio run` and defined in cmd_run.cc.
-DECLARE_string(output_dir);
 DEFINE_string(from, "", "hybrid mode: real EuRoC ASL folder whose IMU, ground truth and calibration are used");
 DEFINE_string(camera, "features", "camera output: features (features0/data.csv) or images (cam0/cam1 PNGs)");
 DEFINE_uint64(seed, 1, "seed of every random draw; same seed, byte-identical output");

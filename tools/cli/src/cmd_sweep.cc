@@ -21,9 +21,9 @@ DEFINE_string(runs, "",
 DEFINE_int32(jobs, 1, "runs at a time (each run is its own process)");
 DEFINE_string(extra_flags, "", "further `vio run` flags for every run, e.g. \"--init=groundtruth --max_iterations=5\"");
 DEFINE_bool(emit_jobs, false, "only write OUTPUT_DIR/jobs.txt, one shell line per run (GNU parallel, Slurm, k8s)");
-DEFINE_bool(collect_only, false, "run nothing: build the table and plots from the run folders there are");
+DEFINE_bool(collect_only, false, "run nothing: build the table, plots and report from the run folders there are");
 DEFINE_string(vio_binary, "", "the vio executable the runs use; empty = this one");
-DEFINE_bool(plots, true, "draw the plots (needs Python 3 with matplotlib)");
+DEFINE_bool(plots, true, "draw the plots and write report.md (needs Python 3 with numpy and matplotlib)");
 DEFINE_string(python, "/usr/bin/python3", "the Python 3 (with numpy and matplotlib) that draws the plots");
 DEFINE_string(plot_script, "", "tools/plot_sweep.py; empty = the one of this source tree");
 DECLARE_string(config);

@@ -76,8 +76,11 @@ std::string ToText(const TrajectoryEvaluation& e) {
   std::ostringstream os;
   os << "alignment   " << AlignmentName(e.alignment) << " (scale " << Fixed(e.alignment_result.scale, 6)
      << ")\n"
-     << "poses       " << ate.num_poses << " compared, " << ate.num_skipped
-     << " skipped (no ground truth)\n"
+     << "poses       " << ate.num_poses << " compared with the ground truth"
+     << (ate.num_skipped == 0 ? std::string(" (all)")
+                              : ", " + std::to_string(ate.num_skipped) +
+                                    " not (outside its time span or in a gap of it)")
+     << "\n"
      << "ATE [m]     rmse " << Fixed(ate.rmse_m, 4) << "  mean " << Fixed(ate.mean_m, 4) << "  median "
      << Fixed(ate.median_m, 4) << "  max " << Fixed(ate.max_m, 4) << "\n"
      << "ATE rot     rmse " << Fixed(ate.rot_rmse_deg, 3) << " deg\n"

@@ -94,6 +94,7 @@ class Estimator {
   std::int64_t next_state_id_ = 0;
   std::string waiting_reason_;
   int rejected_observations_ = 0;
+  bool waiting_while_moving_ = false;  ///< the IMU moved at the last frame before initialization
 };
 
 }  // namespace vio

@@ -23,6 +23,9 @@ struct InitialState {
 struct StaticInitResult {
   std::optional<InitialState> state;
   std::string reason;  ///< set when `state` is empty
+  /// Set when `state` is empty because the IMU moves; a start of the data
+  /// with too few samples yet to judge is the normal case, and not this.
+  bool moving = false;
 };
 
 /// Looks at the IMU in [t_ns - static_window_s, t_ns]: when it is still

@@ -13,6 +13,9 @@ struct Subcommand {
   /// Runs with gflags already parsed; `args` are the positional arguments.
   /// Returns the process exit code.
   int (*main)(const std::vector<std::string>& args);
+  /// Flags the command takes that another file defines (e.g. "output_dir",
+  /// "config", "seed"); `--help` lists them with the command's own flags.
+  std::vector<std::string> shared_flags = {};
   /// Takes the run configuration (YAML + option flags); `--help` lists them.
   bool takes_run_config = false;
 };
