@@ -1,0 +1,176 @@
+// Window's second operation, Gauss-Newton steps (paper §2.2): the column
+// layout by ids, the exact GN path (gauss_newton.h) and the Levenberg-Marquardt
+// path through ceres::Solve with id-ordered elimination groups.
+#include <cmath>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <glog/logging.h>
+
+#include "vio/estimator/window.h"
+
+namespace vio {
+
+std::set<const double*> Window::BlocksInPriors() const {
+  std::set<const double*> in_prior;
+  for (const Prior& prior : priors_) in_prior.insert(prior.blocks.begin(), prior.blocks.end());
+  return in_prior;
+}
+
+std::vector<ceres::ResidualBlockId> Window::ResidualOrder() const {
+  std::vector<ceres::ResidualBlockId> order;
+  order.reserve(static_cast<size_t>(problem_->NumResidualBlocks()));
+  for (const Prior& prior : priors_) order.push_back(prior.residual);
+  for (const auto& [to, edge] : imu_edges_) order.push_back(edge.residual);
+  for (const auto& [key, observation] : observations_) order.push_back(observation.residual);
+  CHECK_EQ(static_cast<int>(order.size()), problem_->NumResidualBlocks()) << "a residual block the window does not know";
+  return order;
+}
+
+GaussNewtonLayout Window::Layout() const {
+  const std::set<const double*> in_prior = BlocksInPriors();
+  GaussNewtonLayout layout;
+  layout.residuals = ResidualOrder();
+  const auto variable = [this](const double* block) { return !problem_->IsParameterBlockConstant(block); };
+  for (const auto& [id, s] : states_) {
+    for (const double* block : {s.pose, s.speed_bias}) {
+      if (variable(block)) layout.dense.push_back(const_cast<double*>(block));
+    }
+  }
+  for (const auto& [id, landmark] : landmarks_) {
+    if (!variable(landmark.p_w)) continue;
+    auto& group = in_prior.count(landmark.p_w) ? layout.dense : layout.eliminated;
+    group.push_back(const_cast<double*>(landmark.p_w));
+  }
+  return layout;
+}
+
+// Landmarks (group 0) are eliminated first by the Schur complement; the
+// state blocks follow, one group each in id order. Ceres orders the blocks
+// inside one group by address, so LM runs depend on the heap layout in the
+// last digits (gn does not: Layout() is by id). Landmarks tied together by a
+// prior are not an independent set: they join the states, after them.
+std::shared_ptr<ceres::ParameterBlockOrdering> Window::SchurOrdering() const {
+  const std::set<const double*> in_prior = BlocksInPriors();
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  int group = 1;
+  for (const auto& [id, s] : states_) {
+    ordering->AddElementToGroup(const_cast<double*>(s.pose), group++);
+    ordering->AddElementToGroup(const_cast<double*>(s.speed_bias), group++);
+  }
+  for (const auto& [id, landmark] : landmarks_) {
+    const bool eliminated = in_prior.count(landmark.p_w) == 0;
+    ordering->AddElementToGroup(const_cast<double*>(landmark.p_w), eliminated ? 0 : group++);
+  }
+  return ordering;
+}
+
+// For sparse Cholesky of the whole normal equations: the states first, then
+// the landmarks. A whole sequence sees few landmarks many times, so
+// eliminating the states (a chain, little fill) leaves a small dense system
+// over the landmarks; eliminating the landmarks first would leave a large,
+// nearly dense one over the states.
+std::shared_ptr<ceres::ParameterBlockOrdering> Window::StatesFirstOrdering() const {
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (const auto& [id, s] : states_) {
+    ordering->AddElementToGroup(const_cast<double*>(s.pose), 0);
+    ordering->AddElementToGroup(const_cast<double*>(s.speed_bias), 0);
+  }
+  for (const auto& [id, landmark] : landmarks_) ordering->AddElementToGroup(const_cast<double*>(landmark.p_w), 1);
+  return ordering;
+}
+
+// Ceres' linear solver and elimination ordering for `linear_solver`.
+void Window::ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const {
+  if (linear_solver == "sparse_full") {
+    solver->linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    solver->linear_solver_ordering = StatesFirstOrdering();
+    return;
+  }
+  solver->linear_solver_ordering = SchurOrdering();
+  // With nothing to eliminate (every landmark tied into a prior, as in
+  // EKF-SLAM) the Schur complement only adds overhead.
+  const bool eliminable = solver->linear_solver_ordering->GroupSize(0) > 0;
+  if (!eliminable) solver->linear_solver_ordering.reset();
+  if (linear_solver == "iterative") {
+    solver->linear_solver_type = eliminable ? ceres::ITERATIVE_SCHUR : ceres::CGNR;
+    solver->preconditioner_type = eliminable ? ceres::SCHUR_JACOBI : ceres::JACOBI;
+  } else if (linear_solver == "sparse") {
+    solver->linear_solver_type = eliminable ? ceres::SPARSE_SCHUR : ceres::SPARSE_NORMAL_CHOLESKY;
+  } else {
+    solver->linear_solver_type = eliminable ? ceres::DENSE_SCHUR : ceres::DENSE_NORMAL_CHOLESKY;
+  }
+}
+
+SolveReport Window::Solve(const SolverOptions& options) {
+  if (options.step == "gn") return GaussNewton(options.max_iterations, /*until_converged=*/true, options);
+  ceres::Solver::Options solver;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = options.function_tolerance;
+  return LevenbergMarquardt(solver, options);
+}
+
+SolveReport Window::TakeSteps(int steps, const SolverOptions& options) {
+  CHECK_GE(steps, 1);
+  if (options.step == "gn") return GaussNewton(steps, /*until_converged=*/false, options);
+  ceres::Solver::Options solver;
+  solver.max_num_iterations = steps;
+  solver.function_tolerance = 0;
+  solver.gradient_tolerance = 0;
+  solver.parameter_tolerance = 0;
+  return LevenbergMarquardt(solver, options);
+}
+
+SolveReport Window::GaussNewton(int max_steps, bool until_converged, const SolverOptions& options) {
+  SolveReport report;
+  const GaussNewtonLayout layout = Layout();
+  for (int k = 0; k < max_steps; ++k) {
+    const GaussNewtonStep step = TakeGaussNewtonStep(problem_.get(), layout);
+    if (k == 0) report.initial_cost = report.final_cost = step.cost;
+    if (!step.ok) {
+      report.usable = false;
+      ++health_.failed_solves;
+      break;
+    }
+    ++report.iterations;
+    double cost = 0;
+    if (!EvaluateCost(problem_.get(), layout, &cost)) {
+      report.usable = false;
+      ++health_.failed_solves;
+      break;
+    }
+    report.final_cost = cost;
+    VLOG(2) << "gn step " << k << ": cost " << step.cost << " -> " << cost << ", |dx| " << step.step_norm;
+    const bool small_change = std::abs(step.cost - cost) <= options.function_tolerance * step.cost;
+    const bool small_step =
+        step.step_norm <= options.parameter_tolerance * (step.values_norm + options.parameter_tolerance);
+    if (until_converged && (small_change || small_step)) {
+      report.converged = true;
+      break;
+    }
+  }
+  return report;
+}
+
+SolveReport Window::LevenbergMarquardt(const ceres::Solver::Options& base, const SolverOptions& options) {
+  ceres::Solver::Options solver = base;
+  ChooseLinearSolver(options.linear_solver, &solver);
+  if (options.max_solver_time_s > 0) solver.max_solver_time_in_seconds = options.max_solver_time_s;
+  solver.num_threads = options.num_threads;
+  solver.minimizer_progress_to_stdout = false;
+  solver.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, problem_.get(), &summary);
+  SolveReport report;
+  report.iterations = static_cast<int>(summary.iterations.size());
+  report.initial_cost = summary.initial_cost;
+  report.final_cost = summary.final_cost;
+  report.usable = summary.IsSolutionUsable();
+  report.converged = summary.termination_type == ceres::CONVERGENCE;
+  if (!report.usable) ++health_.failed_solves;
+  return report;
+}
+
+}  // namespace vio
