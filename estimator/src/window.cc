@@ -101,7 +101,7 @@ void Window::AddImuResidual(ImuEdge& edge) {
   State& a = state(edge.from);
   State& b = state(edge.to);
   const Eigen::Vector3d g_w(0, 0, -model_.gravity);
-  edge.residual = problem_->AddResidualBlock(ImuFactor::Create(edge.preintegration, g_w), nullptr,
+  edge.residual = problem_->AddResidualBlock(Wrap(ImuFactor::Create(edge.preintegration, g_w)), nullptr,
                                              a.pose, a.speed_bias, b.pose, b.speed_bias);
 }
 
@@ -143,9 +143,39 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
   CHECK(observations_.count(key) == 0) << "landmark " << landmark_id.value << " observed twice in state "
                                       << state_id.value;
   ceres::ResidualBlockId residual = problem_->AddResidualBlock(
-      StereoFactor::Create(z_px, stereo_, model_.pixel_sigma), loss_.get(), s.pose, it->second.p_w);
+      Wrap(StereoFactor::Create(z_px, stereo_, model_.pixel_sigma)), loss_.get(), s.pose, it->second.p_w);
   observations_[key] = Observation{z_px, residual};
   it->second.observed_from.insert(state_id);
+}
+
+std::vector<double*> Window::Blocks(const std::vector<StateId>& state_ids,
+                                   const std::vector<LandmarkId>& landmark_ids) {
+  std::vector<double*> blocks;
+  for (StateId id : state_ids) {
+    State& s = state(id);
+    blocks.push_back(s.pose);
+    blocks.push_back(s.speed_bias);
+  }
+  for (LandmarkId id : landmark_ids) {
+    auto it = landmarks_.find(id);
+    CHECK(it != landmarks_.end()) << "no landmark " << id.value << " in the window";
+    blocks.push_back(it->second.p_w);
+  }
+  return blocks;
+}
+
+void Window::AddLinearFactor(const std::vector<StateId>& state_ids, const std::vector<LandmarkId>& landmark_ids,
+                             const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residual) {
+  const std::vector<double*> blocks = Blocks(state_ids, landmark_ids);
+  std::vector<marginalization::MarginalizationPrior::Block> prior_blocks;
+  for (double* block : blocks) {
+    const bool pose = problem_->GetManifold(block) != nullptr;
+    const int size = problem_->ParameterBlockSize(block);
+    prior_blocks.push_back({pose ? pose_manifold_.get() : nullptr, std::vector<double>(block, block + size)});
+  }
+  auto factor = marginalization::MarginalizationPrior::Create(std::move(prior_blocks), jacobian, residual);
+  const ceres::ResidualBlockId id = problem_->AddResidualBlock(Wrap(factor.release()), nullptr, blocks);
+  priors_.push_back(Prior{id, {blocks.begin(), blocks.end()}});
 }
 
 void Window::SetStateConstant(StateId id, bool constant) {
@@ -188,17 +218,7 @@ int Window::RefreshImuFactors(double gyro_bias_threshold) {
 }
 
 void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vector<LandmarkId>& landmark_ids) {
-  std::vector<double*> blocks;
-  for (StateId id : state_ids) {
-    State& s = state(id);
-    blocks.push_back(s.pose);
-    blocks.push_back(s.speed_bias);
-  }
-  for (LandmarkId id : landmark_ids) {
-    auto it = landmarks_.find(id);
-    CHECK(it != landmarks_.end()) << "marginalizing unknown landmark " << id.value;
-    blocks.push_back(it->second.p_w);
-  }
+  std::vector<double*> blocks = Blocks(state_ids, landmark_ids);
   if (blocks.empty()) return;
   marginalization::MarginalizationOptions options;
   options.residual_order = ResidualOrder();

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -102,6 +103,22 @@ void Window::ChooseLinearSolver(const std::string& linear_solver, ceres::Solver:
   } else {
     solver->linear_solver_type = eliminable ? ceres::DENSE_SCHUR : ceres::DENSE_NORMAL_CHOLESKY;
   }
+}
+
+Eigen::MatrixXd Window::Information(const std::vector<StateId>& state_ids,
+                                    const std::vector<LandmarkId>& landmark_ids) {
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = Blocks(state_ids, landmark_ids);
+  evaluate.residual_blocks = ResidualOrder();
+  ceres::CRSMatrix crs;
+  if (!problem_->Evaluate(evaluate, nullptr, nullptr, nullptr, &crs)) {
+    throw std::runtime_error("Window::Information: the cost does not evaluate at the current values");
+  }
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) J(row, crs.cols[k]) = crs.values[k];
+  }
+  return J.transpose() * J;
 }
 
 SolveReport Window::Solve(const SolverOptions& options) {

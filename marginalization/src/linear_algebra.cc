@@ -12,6 +12,9 @@
 namespace vio::marginalization {
 namespace {
 
+// Largest relative error ||Jp^T Jp - H||_F / ||H||_F the pivoted LDLT square root may leave.
+constexpr double kReconstructionTolerance = 1e-13;
+
 /// The eigen-pairs of a symmetric PSD matrix whose eigenvalue survives the
 /// threshold: H ~= eigenvectors * diag(eigenvalues) * eigenvectors^T.
 struct SignificantEigenpairs {
@@ -132,8 +135,15 @@ SqrtInformation SqrtByPivotedLdlt(const Eigen::MatrixXd& H, const Eigen::VectorX
       (ldlt.transpositionsP().transpose() * Eigen::MatrixXd(ldlt.matrixL())).transpose();
   const Eigen::VectorXd Linv_P_b = ldlt.matrixL().solve(ldlt.transpositionsP() * b);
   const Eigen::VectorXd sqrt_D = D(kept).cwiseSqrt();
-  return {sqrt_D.asDiagonal() * Lt_P(kept, Eigen::all),
-          sqrt_D.cwiseInverse().asDiagonal() * Linv_P_b(kept)};
+  SqrtInformation sqrt{sqrt_D.asDiagonal() * Lt_P(kept, Eigen::all),
+                       sqrt_D.cwiseInverse().asDiagonal() * Linv_P_b(kept)};
+  // On a rank-deficient H (marginalized features leave one) a pivot at the
+  // round-off level can come before larger ones, and the pivots after it are
+  // amplified round-off: then the factor does not give H back, and the
+  // eigen-decomposition, which drops exactly the weak directions, is used.
+  const double reconstruction = (sqrt.sqrt_information.transpose() * sqrt.sqrt_information - H).norm();
+  if (!(reconstruction <= kReconstructionTolerance * H.norm())) return SqrtByEigen(H, b, threshold);
+  return sqrt;
 }
 
 }  // namespace

@@ -203,6 +203,39 @@ TEST_P(SqrtInformationFromHessianTest, ThresholdsDropSmallEigenvalues) {
   EXPECT_EQ(SqrtInformationFromHessian(H, b, threshold, GetParam()).sqrt_information.rows(), 1);
 }
 
+// Marginalizing features seen from few poses leaves a rank-deficient H* with
+// round-off where it should be zero; a pivot at that level may come early in
+// the pivoted LDLT, and the pivots after it are amplified round-off. The
+// square root must still give H* back (as the eigen-decomposition does).
+TEST_P(SqrtInformationFromHessianTest, ReconstructsTheRankDeficientMarginalOfFeatures) {
+  std::mt19937 engine(7);
+  std::normal_distribution<double> normal;
+  auto random = [&](int rows, int cols) {
+    return Eigen::MatrixXd(Eigen::MatrixXd::NullaryExpr(rows, cols, [&] { return normal(engine); }));
+  };
+  for (int trial = 0; trial < 20; ++trial) {
+    const int poses = 4, features = 3;
+    const int n = 6 * poses;
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n + 3 * features, n + 3 * features);
+    for (int f = 0; f < features; ++f) {
+      for (int pose = 0; pose < 2; ++pose) {  // each feature seen from two poses: rank-deficient marginal
+        const int i = (f + pose) % poses;
+        Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3, n + 3 * features);
+        J.middleCols(6 * i, 6) = 100.0 * random(3, 6);
+        Eigen::Matrix3d J_f = 100.0 * random(3, 3);
+        J_f.col(2) *= 1e-2;  // depth weakly observed
+        J.middleCols(n + 3 * f, 3) = J_f;
+        H += J.transpose() * J;
+      }
+    }
+    const NormalEquations marginal =
+        SchurComplement(H, random(n + 3 * features, 1), n, 3 * features, RankThreshold{});
+    const SqrtInformation sqrt = SqrtInformationFromHessian(marginal.H, marginal.b, RankThreshold{}, GetParam());
+    const Eigen::MatrixXd back = sqrt.sqrt_information.transpose() * sqrt.sqrt_information;
+    EXPECT_LE((back - marginal.H).norm(), 1e-10 * marginal.H.norm()) << "trial " << trial;
+  }
+}
+
 TEST_P(SqrtInformationFromHessianTest, RejectsNonSquareInput) {
   EXPECT_THROW(SqrtInformationFromHessian(Eigen::MatrixXd::Zero(3, 2), Eigen::VectorXd::Zero(3), {},
                                           GetParam()),

@@ -107,8 +107,8 @@ const std::vector<Subcommand>& Subcommands() {
       {"eval", "trajectory error (ATE, RPE) of an estimate against ground truth",
        "vio eval --estimate=FILE --groundtruth=FILE_OR_DIR [--alignment=posyaw|se3|sim3|none] [--json=FILE]",
        &EvalMain},
-      {"verify", "check the paper's filter = optimization equivalence theorems on random problems",
-       "vio verify [--seed=N] [--num_landmarks=N] [--num_poses=N] [--trials=N]", &VerifyMain, {"seed"}},
+      {"verify", "check the paper's filter = optimization theorems through the estimator's window on random problems",
+       "vio verify [--seed=N] [--num_landmarks=N] [--num_poses=N] [--trials=N] [--json=FILE]", &VerifyMain, {"seed", "json"}},
       {"sweep", "run every dataset x policy x window size, N at a time; table, CSV, plots and report",
        "vio sweep --datasets=DIR,... --policies=swf,... --window_sizes=5,10,... --output_dir=DIR [--jobs=N] "
        "[--config=FILE] [--extra_flags=\"--init=groundtruth ...\"] [--emit_jobs | --collect_only]",

@@ -19,7 +19,7 @@ DEFINE_string(groundtruth, "",
 DEFINE_string(alignment, "posyaw", "estimate-to-ground-truth alignment: posyaw|se3|sim3|none");
 DEFINE_string(rpe_lengths, "1,2,5,10",
               "RPE sub-trajectory lengths along the ground truth [m], comma separated");
-DEFINE_string(json, "", "also write the report as JSON to this file (optional)");
+DEFINE_string(json, "", "also write the report as JSON to this file (optional; vio verify: its rows)");
 DEFINE_double(max_gt_gap_s, 0,
               "ground truth is not interpolated across gaps longer than this; estimates inside are skipped; "
               "0 = 10 median ground-truth sample intervals (EuRoC: 0.05 s) [s] valid: [0, inf)");

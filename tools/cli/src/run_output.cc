@@ -7,6 +7,8 @@
 #include <map>
 #include <sstream>
 
+#include "json_writer.h"
+
 namespace vio::tools {
 namespace {
 
@@ -14,13 +16,6 @@ std::ofstream OpenForWriting(const std::string& path) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error(path + ": cannot open for writing");
   return out;
-}
-
-std::string Number(double value) {
-  if (!std::isfinite(value)) return "null";
-  std::ostringstream os;
-  os << std::setprecision(8) << value;
-  return os.str();
 }
 
 // Mean over frames of one stage time.
@@ -34,25 +29,12 @@ double MeanMs(const std::vector<FrameEstimate>& frames, Get get) {
 
 std::string StageTimesJson(const std::vector<FrameEstimate>& f) {
   std::ostringstream os;
-  os << "{\"propagate\": " << Number(MeanMs(f, [](auto& e) { return e.timing.propagate_ms; }))
-     << ", \"build\": " << Number(MeanMs(f, [](auto& e) { return e.timing.policy.build_ms; }))
-     << ", \"solve\": " << Number(MeanMs(f, [](auto& e) { return e.timing.policy.solve_ms; }))
-     << ", \"marginalize\": " << Number(MeanMs(f, [](auto& e) { return e.timing.policy.marginalize_ms; }))
-     << ", \"total\": " << Number(MeanMs(f, [](auto& e) { return e.timing.total_ms; })) << "}";
+  os << "{\"propagate\": " << JsonNumber(MeanMs(f, [](auto& e) { return e.timing.propagate_ms; }))
+     << ", \"build\": " << JsonNumber(MeanMs(f, [](auto& e) { return e.timing.policy.build_ms; }))
+     << ", \"solve\": " << JsonNumber(MeanMs(f, [](auto& e) { return e.timing.policy.solve_ms; }))
+     << ", \"marginalize\": " << JsonNumber(MeanMs(f, [](auto& e) { return e.timing.policy.marginalize_ms; }))
+     << ", \"total\": " << JsonNumber(MeanMs(f, [](auto& e) { return e.timing.total_ms; })) << "}";
   return os.str();
-}
-
-std::string JsonString(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (c == '\n') {
-      out += "\\n";
-      continue;
-    }
-    out += c;
-  }
-  return out + "\"";
 }
 
 std::string HealthJson(const RunHealth& h) {
@@ -112,8 +94,8 @@ void RunOutput::WriteTiming() const {
          "solver_iterations,states,landmarks,observations\n";
   for (const FrameEstimate& f : frames_) {
     const PolicyTiming& p = f.timing.policy;
-    out << f.t_ns << "," << Number(f.timing.propagate_ms) << "," << Number(p.build_ms) << ","
-        << Number(p.solve_ms) << "," << Number(p.marginalize_ms) << "," << Number(f.timing.total_ms) << ","
+    out << f.t_ns << "," << JsonNumber(f.timing.propagate_ms) << "," << JsonNumber(p.build_ms) << ","
+        << JsonNumber(p.solve_ms) << "," << JsonNumber(p.marginalize_ms) << "," << JsonNumber(f.timing.total_ms) << ","
         << p.solver_iterations << "," << f.num_states << "," << f.num_landmarks << "," << f.num_observations
         << "\n";
   }
@@ -127,17 +109,17 @@ void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_jso
       << ",\n  \"window_size\": " << policy.window_size << ",\n  \"status\": " << JsonString(r.status)
       << ",\n  \"problems\": " << ProblemsJson(r.problems) << ",\n  \"health\": " << HealthJson(r.health)
       << ",\n  \"frames\": " << r.frames << ",\n  \"frames_estimated\": " << r.frames_estimated
-      << ",\n  \"dataset_duration_s\": " << Number(r.dataset_duration_s)
-      << ",\n  \"processing_s\": " << Number(r.processing_s) << ",\n  \"ms_per_frame\": " << Number(r.ms_per_frame)
-      << ",\n  \"real_time_factor\": " << Number(r.real_time_factor)
+      << ",\n  \"dataset_duration_s\": " << JsonNumber(r.dataset_duration_s)
+      << ",\n  \"processing_s\": " << JsonNumber(r.processing_s) << ",\n  \"ms_per_frame\": " << JsonNumber(r.ms_per_frame)
+      << ",\n  \"real_time_factor\": " << JsonNumber(r.real_time_factor)
       << ",\n  \"stage_ms_per_frame\": " << StageTimesJson(frames_)
-      << ",\n  \"peak_memory_mb\": " << Number(peak_memory_mb) << ",\n  \"frame_gaps\": {\"count\": " << r.frame_gaps
-      << ", \"longest_s\": " << Number(r.longest_frame_gap_s) << "},\n  \"tracking_loss\": {\"untracked_frames\": "
+      << ",\n  \"peak_memory_mb\": " << JsonNumber(peak_memory_mb) << ",\n  \"frame_gaps\": {\"count\": " << r.frame_gaps
+      << ", \"longest_s\": " << JsonNumber(r.longest_frame_gap_s) << "},\n  \"tracking_loss\": {\"untracked_frames\": "
       << r.tracking.untracked_frames << ", \"losses\": " << r.tracking.losses << ", \"losses_beyond_window\": "
-      << r.tracking.losses_beyond_window << ", \"longest_s\": " << Number(r.tracking.longest_loss_s)
+      << r.tracking.losses_beyond_window << ", \"longest_s\": " << JsonNumber(r.tracking.longest_loss_s)
       << "},\n  \"frontend\": " << frontend_json;
   if (!waiting_reason.empty()) out << ",\n  \"not_initialized_reason\": " << JsonString(waiting_reason);
-  if (r.groundtruth_tilt_deg) out << ",\n  \"groundtruth_tilt_deg\": " << Number(*r.groundtruth_tilt_deg);
+  if (r.groundtruth_tilt_deg) out << ",\n  \"groundtruth_tilt_deg\": " << JsonNumber(*r.groundtruth_tilt_deg);
   if (r.evaluation) {
     std::string evaluation = ToJson(*r.evaluation);
     for (size_t pos = 0; (pos = evaluation.find('\n', pos)) != std::string::npos; pos += 3) {

@@ -9,6 +9,7 @@
 //             linearized prior (vio_marginalization) on the same problem;
 //             Drop*(): remove without keeping their information.
 // Policies (policy.h) are functions over a Window.
+#include <functional>
 #include <map>
 #include <memory>
 #include <set>
@@ -93,6 +94,15 @@ class Window {
   Landmark& AddLandmark(LandmarkId id, const Eigen::Vector3d& p_w);
   /// Stereo observation z = (u_L, u_R, v) [px] of `landmark` from `state`.
   void AddObservation(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px);
+  /// A linear factor r = residual + jacobian [x ⊟ x0], x0 the current values, over the states'
+  /// [pose, speed_bias] and the landmarks in that order; kept as a prior. A Gaussian N(x0, Σ) is
+  /// jacobian = Σ^-1/2, residual = 0. Throws std::invalid_argument on inconsistent sizes.
+  void AddLinearFactor(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks,
+                       const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residual);
+  /// Wraps every factor the window creates from now on (a test's factor with a wrong Jacobian);
+  /// the wrapper takes ownership of the factor it is given. Empty: none.
+  using FactorWrapper = std::function<ceres::CostFunction*(ceres::CostFunction*)>;
+  void SetFactorWrapper(FactorWrapper wrapper) { wrapper_ = std::move(wrapper); }
 
   // ---- Gauss-Newton ---------------------------------------------------------
   /// Steps to convergence. step=gn: undamped Gauss-Newton steps until the
@@ -105,6 +115,10 @@ class Window {
   SolveReport TakeSteps(int steps, const SolverOptions& options);
   /// Re-preintegrates IMU factors whose gyro-bias linearization moved too far.
   int RefreshImuFactors(double gyro_bias_threshold);
+  /// J^T J of the whole cost at the current values over the tangent spaces of the states'
+  /// [pose, speed_bias] and the landmarks, in that order, every other block held: the information
+  /// of one Gauss-Newton step (after Marginalize: of the priors); its inverse is the covariance.
+  Eigen::MatrixXd Information(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks);
 
   /// Holds a state's or landmark's blocks fixed in Solve (or frees them).
   void SetStateConstant(StateId id, bool constant);
@@ -166,6 +180,9 @@ class Window {
   using ObservationKey = std::pair<StateId, LandmarkId>;
 
   void AddImuResidual(ImuEdge& edge);
+  ceres::CostFunction* Wrap(ceres::CostFunction* factor) const { return wrapper_ ? wrapper_(factor) : factor; }
+  /// The parameter blocks of states ([pose, speed_bias] each), then landmarks.
+  std::vector<double*> Blocks(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks);
   SolveReport GaussNewton(int max_steps, bool until_converged, const SolverOptions& options);
   SolveReport LevenbergMarquardt(const ceres::Solver::Options& base, const SolverOptions& options);
   /// Variable blocks in id order: states, then landmarks tied by a prior
@@ -194,6 +211,7 @@ class Window {
   std::vector<Prior> priors_;
   Removals removals_;
   WindowHealth health_;
+  FactorWrapper wrapper_;
 };
 
 }  // namespace vio
