@@ -30,7 +30,22 @@ DEFINE_double(max_range, 20.0, "farthest observable landmark [m]");
 DEFINE_double(max_speed, 2.0, "synthetic flight speed limit [m/s]");
 DEFINE_double(max_rotation_rate, 1.5, "synthetic flight angular rate limit [rad/s]");
 DEFINE_double(sim_imu_noise, 1.0, "synthetic IMU noise and bias random walk, times the EuRoC densities");
-DEFINE_double(image_noise, 1.0, "rendered image noise, standard deviation [grey levels]");
+DEFINE_string(texture_dir, "../shared/data/euroc/V1_01_easy_micro,../shared/data/euroc/V1_01_easy_flight10",
+              "rendered images: folders of real grey images (an ASL folder: its cam0) the surfaces are textured "
+              "with, read in place, comma-separated; none found: procedural textures with a warning; empty: "
+              "procedural");
+DEFINE_double(texel_size, 0.006, "rendered images: size of one texture image pixel on a surface [m]");
+DEFINE_double(exposure_ms, 5.0, "rendered images: nominal exposure time, the motion blur integrates the true "
+              "motion over it (0: no blur) [ms]");
+DEFINE_double(exposure_variation, 0.25, "rendered images: auto-exposure changes, exposure time and brightness "
+              "vary smoothly by up to a factor exp(+-this) [ln factor]");
+DEFINE_double(exposure_period, 8.0, "rendered images: period of the slowest exposure change [s]");
+DEFINE_int32(max_blur_samples, 12, "rendered images: most sub-frames integrated per exposure, spaced <= 0.5 px "
+             "of image motion apart (1: no motion blur)");
+DEFINE_double(vignetting, 0.3, "rendered images: brightness loss at the farthest image corner [0, 1)");
+DEFINE_double(image_noise, 1.0, "rendered images: read noise, standard deviation [grey levels]");
+DEFINE_double(shot_noise, 1.5, "rendered images: shot noise at grey 128, standard deviation [grey levels] "
+              "(variance proportional to the signal)");
 DEFINE_int32(png_compression, 1, "PNG compression level of rendered images, 0..9");
 DEFINE_double(drop_frames, 0.0, "fraction of the camera frames removed, in gaps of --drop_gap_frames [0, 1)");
 DEFINE_int32(drop_gap_frames, 1, "consecutive frames removed per gap (1 at 20 Hz: 100 ms gaps)");
@@ -88,6 +103,15 @@ SimulatorOptions OptionsFromFlags() {
   options.trajectory.max_rotation_rate_rad_s = FLAGS_max_rotation_rate;
   options.imu.noise_scale = FLAGS_sim_imu_noise;
   options.render.image_noise_sigma = FLAGS_image_noise;
+  options.textures.dirs = FLAGS_texture_dir;
+  options.textures.texel_m = FLAGS_texel_size;
+  options.sensor.exposure_ms = FLAGS_exposure_ms;
+  options.sensor.exposure_variation = FLAGS_exposure_variation;
+  options.sensor.exposure_period_s = FLAGS_exposure_period;
+  options.sensor.max_blur_samples = FLAGS_max_blur_samples;
+  options.sensor.vignetting = FLAGS_vignetting;
+  options.sensor.read_noise = FLAGS_image_noise;
+  options.sensor.shot_noise = FLAGS_shot_noise;
   options.png_compression = FLAGS_png_compression;
   options.gaps.drop_fraction = FLAGS_drop_frames;
   options.gaps.gap_frames = FLAGS_drop_gap_frames;

@@ -9,7 +9,11 @@
 
 #include <glog/logging.h>
 
+#include <opencv2/core/utility.hpp>
+
+#include "hash.h"
 #include "vio/frontend/camera_model.h"
+#include "vio/simulator/sensor.h"
 
 namespace vio::tools {
 namespace {
@@ -21,22 +25,6 @@ constexpr std::array<std::uint64_t, 4> kRectangleEighths = {6, 4, 3, 2};
 constexpr float kCellOffset = 4096.0f;  // keeps cell coordinates positive ...
 constexpr double kMaxCoordinate = 150.0;  // ... for rooms within this distance of the origin [m]
 constexpr float kMinCellPixels = 3.0f;  // finer texture levels are skipped (anti-aliasing)
-
-// splitmix64 finalizer: a fast, well-mixed 64-bit hash.
-inline std::uint64_t Mix(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
-inline float UnitFromBits(std::uint64_t bits) { return static_cast<float>(bits & 255u) * (1.0f / 255.0f); }
-
-// Approximately standard normal from one hash: sum of four 16-bit uniforms.
-inline float HashNormal(std::uint64_t h) {
-  const float sum = static_cast<float>((h & 0xffff) + ((h >> 16) & 0xffff) + ((h >> 32) & 0xffff) + (h >> 48));
-  return (sum * (1.0f / 65536.0f) - 2.0f) * 1.7320508f;  // var of each uniform is 1/12
-}
 
 struct SurfaceHit {
   float t = std::numeric_limits<float>::infinity();  // [m]
@@ -73,10 +61,11 @@ inline SurfaceHit CastRay(const Eigen::Vector3f& room_min, const Eigen::Vector3f
 }  // namespace
 
 SceneRenderer::SceneRenderer(const Scene& scene, const CameraCalibration& camera,
-                             const RenderOptions& options)
+                             const RenderOptions& options, const ImageTextures* textures)
     : scene_(scene),
       camera_(camera),
       options_(options),
+      image_textures_(textures != nullptr && !textures->empty() ? textures : nullptr),
       room_min_(scene.room.min().cast<float>()),
       room_max_(scene.room.max().cast<float>()) {
   if (!(scene.room.min().cwiseAbs().maxCoeff() < kMaxCoordinate && scene.room.max().cwiseAbs().maxCoeff() < kMaxCoordinate)) {
@@ -127,11 +116,29 @@ void SceneRenderer::BuildTextures() {
       texture.levels[level] = {level_key, kCellOffset + UnitFromBits(level_key),
                                kCellOffset + UnitFromBits(level_key >> 8)};
     }
+    if (image_textures_ == nullptr) continue;
+    const std::uint64_t image_key = Mix(surface_key ^ 0x696d616765ULL);
+    texture.image = image_key % image_textures_->pyramids.size();
+    const cv::Mat& level0 = image_textures_->pyramids[texture.image][0];
+    // Large positive offsets keep texel coordinates positive (mirrored repeat).
+    texture.image_x = static_cast<float>(2 * kCellOffset * level0.cols + (image_key >> 16) % level0.cols);
+    texture.image_y = static_cast<float>(2 * kCellOffset * level0.rows + (image_key >> 32) % level0.rows);
+    texture.swap_axes = (image_key >> 8) & 1u;
+    texture.sign_a = (image_key >> 9) & 1u ? -1.0f : 1.0f;
+    texture.sign_b = (image_key >> 10) & 1u ? -1.0f : 1.0f;
   }
+}
+
+float SceneRenderer::ImageGrey(const SurfaceTexture& texture, float a, float b, float footprint_m) const {
+  const float inverse_texel = static_cast<float>(1.0 / image_textures_->texel_m);
+  float x = texture.sign_a * a * inverse_texel, y = texture.sign_b * b * inverse_texel;
+  if (texture.swap_axes) std::swap(x, y);
+  return image_textures_->Sample(texture.image, texture.image_x + x, texture.image_y + y, footprint_m * inverse_texel);
 }
 
 float SceneRenderer::SurfaceGrey(int surface, float a, float b, float footprint_m) const {
   const SurfaceTexture& texture = textures_[surface];
+  if (image_textures_ != nullptr) return ImageGrey(texture, a, b, footprint_m);
   float grey = texture.base_grey;
   for (std::size_t level = 0; level < kCellSizes.size(); ++level) {
     if (kCellSizes[level] < kMinCellPixels * footprint_m) break;
@@ -177,27 +184,36 @@ std::vector<int> SceneRenderer::BoxesPerTile(const Eigen::Isometry3d& T_w_c) con
 
 void SceneRenderer::Render(const Eigen::Isometry3d& T_w_c, std::uint64_t noise_key, cv::Mat* image) const {
   CHECK(image != nullptr);
-  image->create(camera_.height, camera_.width, CV_8UC1);
+  cv::Mat radiance;
+  AddRadiance(T_w_c, 1.0f, &radiance);
+  SensorOptions sensor;
+  sensor.read_noise = options_.image_noise_sigma;
+  sensor.shot_noise = 0.0;
+  ExposeImage(radiance, 1.0, cv::Mat(), sensor, noise_key, image);
+}
+
+void SceneRenderer::AddRadiance(const Eigen::Isometry3d& T_w_c, float weight, cv::Mat* radiance) const {
+  CHECK(radiance != nullptr);
+  if (radiance->rows != camera_.height || radiance->cols != camera_.width || radiance->type() != CV_32FC1) {
+    *radiance = cv::Mat::zeros(camera_.height, camera_.width, CV_32FC1);
+  }
   const std::vector<int> lists = BoxesPerTile(T_w_c);
   const int stride = static_cast<int>(boxes_.size()) + 1;
   const Eigen::Matrix3f R_w_c = T_w_c.linear().cast<float>();
   const Eigen::Vector3f p_w_c = T_w_c.translation().cast<float>();
-  for (std::size_t t = 0; t < tiles_.size(); ++t) {
-    RenderTile(static_cast<int>(t), R_w_c, p_w_c, &lists[t * stride + 1], lists[t * stride], noise_key, image);
-  }
+  cv::parallel_for_(cv::Range(0, static_cast<int>(tiles_.size())), [&](const cv::Range& range) {
+    for (int t = range.start; t < range.end; ++t) {
+      RenderTile(t, R_w_c, p_w_c, &lists[t * stride + 1], lists[t * stride], weight, radiance);
+    }
+  });
 }
 
 void SceneRenderer::RenderTile(int tile, const Eigen::Matrix3f& R_w_c, const Eigen::Vector3f& p_w_c,
-                               const int* boxes, int num_boxes, std::uint64_t noise_key, cv::Mat* image) const {
+                               const int* boxes, int num_boxes, float weight, cv::Mat* radiance) const {
   const float focal = static_cast<float>(camera_.intrinsics[0]);
-  const float noise_sigma = static_cast<float>(options_.image_noise_sigma);
   ForEachPixel(tile, [&](int u, int v, std::size_t index) {
-    std::uint8_t& pixel = image->ptr<std::uint8_t>(v)[u];
     const Eigen::Vector3f& ray_c = rays_c_[index];
-    if (ray_c.isZero()) {
-      pixel = 0;
-      return;
-    }
+    if (ray_c.isZero()) return;  // no light where the lens model has no ray
     Eigen::Vector3f d = R_w_c * ray_c;
     for (int a = 0; a < 3; ++a) {
       if (std::abs(d[a]) < 1e-9f) d[a] = 1e-9f;
@@ -206,9 +222,7 @@ void SceneRenderer::RenderTile(int tile, const Eigen::Matrix3f& R_w_c, const Eig
     const Eigen::Vector3f p = p_w_c + hit.t * d;
     const int a1 = (hit.axis + 1) % 3, a2 = (hit.axis + 2) % 3;
     const float footprint = hit.t / (focal * std::max(std::abs(d[hit.axis]), 0.2f));
-    float grey = SurfaceGrey(hit.surface, p[a1], p[a2], footprint);
-    if (noise_sigma > 0.0f) grey += noise_sigma * HashNormal(Mix(noise_key * 0x2545f4914f6cdd1dULL + index));
-    pixel = static_cast<std::uint8_t>(std::clamp(grey + 0.5f, 0.0f, 255.0f));
+    radiance->ptr<float>(v)[u] += weight * SurfaceGrey(hit.surface, p[a1], p[a2], footprint);
   });
 }
 

@@ -38,6 +38,8 @@ void CheckOptions(const SimulatorOptions& options) {
     throw std::invalid_argument("simulator: duration must be positive, got " +
                                 std::to_string(options.duration_s) + " s");
   }
+  CheckSensorOptions(options.sensor);
+  CheckImageTextureOptions(options.textures);
   if (options.png_compression < 0 || options.png_compression > 9) {
     throw std::invalid_argument("simulator: PNG compression must be in 0..9, got " +
                                 std::to_string(options.png_compression));
@@ -146,19 +148,43 @@ SimulationSummary Summarize(const Simulation& sim, const SimulatorOptions& optio
   return summary;
 }
 
+// The poses of camera `camera` during the exposure of frame i (see ExposurePoses).
+std::vector<Eigen::Isometry3d> CameraExposurePoses(const Simulation& sim, std::size_t i, const CameraCalibration& camera,
+                                                   double exposure_s, const SensorOptions& sensor) {
+  const FramePose& frame = sim.frames[i];
+  auto pose_at = [&](double offset_s) -> std::optional<Eigen::Isometry3d> {
+    if (offset_s == 0.0) return frame.T_w_b * camera.T_b_c;
+    const std::optional<Eigen::Isometry3d> T_w_b =
+        InterpolatePose(sim.dataset.groundtruth, frame.t_ns + SecondsToNanos(offset_s));
+    if (!T_w_b) return std::nullopt;
+    return *T_w_b * camera.T_b_c;
+  };
+  return ExposurePoses(pose_at, exposure_s, camera.intrinsics[0], sensor);
+}
+
 void WriteImages(const Simulation& sim, const SimulatorOptions& options, const RenderProgress& progress) {
   const std::vector<int> png = {cv::IMWRITE_PNG_COMPRESSION, options.png_compression};
   RenderOptions render = options.render;
   render.texture_seed = options.seed;
+  const ImageTextures textures = LoadImageTextures(options.textures);
   const std::int64_t total = 2 * static_cast<std::int64_t>(sim.frames.size());
-  cv::Mat image;
+  cv::Mat radiance, image;
   for (int k = 0; k < 2; ++k) {
     const CameraCalibration& camera = sim.dataset.cameras[k];
-    const SceneRenderer renderer(sim.scene, camera, render);
+    const SceneRenderer renderer(sim.scene, camera, render, &textures);
+    const cv::Mat vignette = VignettingMap(camera, options.sensor.vignetting);
     const std::string folder = options.output_dir + "/mav0/cam" + std::to_string(k) + "/data";
     std::filesystem::create_directories(folder);
     for (std::size_t i = 0; i < sim.frames.size(); ++i) {
-      renderer.Render(sim.frames[i].T_w_b * camera.T_b_c, options.seed * 1'000'003ULL + 2 * i + k, &image);
+      const double brightness =
+          ExposureFactor(options.sensor, options.seed, NanosToSeconds(sim.frames[i].t_ns - sim.frames.front().t_ns));
+      const double exposure_s = 1e-3 * options.sensor.exposure_ms * brightness;
+      const std::vector<Eigen::Isometry3d> poses = CameraExposurePoses(sim, i, camera, exposure_s, options.sensor);
+      radiance.setTo(0.0f);
+      for (const Eigen::Isometry3d& T_w_c : poses) {
+        renderer.AddRadiance(T_w_c, 1.0f / static_cast<float>(poses.size()), &radiance);
+      }
+      ExposeImage(radiance, brightness, vignette, options.sensor, options.seed * 1'000'003ULL + 2 * i + k, &image);
       if (BlackoutAt(sim.frames[i].t_ns, sim.frames.front().t_ns, options.gaps.blackouts) >= 0) {
         image.setTo(cv::Scalar::all(kBlackoutGrey));
       }

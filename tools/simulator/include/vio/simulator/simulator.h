@@ -10,7 +10,10 @@
 //    synthetic room along the real ground truth (interpolated at the real
 //    cam0 stamps; frames outside the ground truth are dropped).
 // The camera side is either feature tracks (features0/data.csv,
-// features.h) or rendered stereo PNG images (cam0/cam1, render.h).
+// features.h) or rendered stereo PNG images (cam0/cam1, render.h): surfaces
+// textured with real images (texture.h), then exposed by a simulated sensor
+// (sensor.h: auto exposure, motion blur along the true motion, vignetting,
+// shot and read noise).
 // Frames can be dropped and blacked out on purpose (gaps.h).
 // Output is deterministic for a given seed.
 #include <array>
@@ -25,6 +28,8 @@
 #include "vio/simulator/imu.h"
 #include "vio/simulator/render.h"
 #include "vio/simulator/scene.h"
+#include "vio/simulator/sensor.h"
+#include "vio/simulator/texture.h"
 #include "vio/simulator/trajectory.h"
 
 namespace vio::tools {
@@ -55,8 +60,13 @@ struct SimulatorOptions {
   FeatureSimOptions features;
   /// Dropped frames and blackouts (none by default).
   FrameGapOptions gaps;
-  /// Image rendering (images mode; texture seed derived from `seed`).
+  /// Image rendering (images mode; texture seed derived from `seed`;
+  /// the noise is the sensor's).
   RenderOptions render;
+  /// Real images the surfaces are textured with (images mode).
+  ImageTextureOptions textures;
+  /// Exposure, motion blur, vignetting and noise of the cameras (images mode).
+  SensorOptions sensor;
   /// PNG compression level 0..9 of rendered images (1: fast, larger files).
   int png_compression = 1;
 };
