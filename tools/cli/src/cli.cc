@@ -116,6 +116,9 @@ const std::vector<Subcommand>& Subcommands() {
       {"convert", "an ASL folder with images to a ROS 1 bag, or a bag to an ASL folder",
        "vio convert --input=DIR_OR_BAG --output=BAG_OR_DIR [--calibration=DIR] [--cam0_topic=/cam0/image_raw ...]",
        &ConvertMain, {}, /*takes_run_config=*/true},
+      {"imagestats", "grey level, contrast, gradient, corner and KLT statistics of stereo image sequences, as a table",
+       "vio imagestats --datasets=DIR,... [--max_frames=200] [--config=FILE]", &ImageStatsMain, {"config", "datasets"},
+       /*takes_run_config=*/true},
   };
   return commands;
 }

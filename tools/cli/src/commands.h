@@ -17,5 +17,6 @@ int EvalMain(const std::vector<std::string>& args);
 int VerifyMain(const std::vector<std::string>& args);
 int SweepMain(const std::vector<std::string>& args);
 int ConvertMain(const std::vector<std::string>& args);
+int ImageStatsMain(const std::vector<std::string>& args);
 
 }  // namespace vio::tools
