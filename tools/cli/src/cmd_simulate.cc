@@ -16,6 +16,8 @@
 #include "vio/simulator/simulator.h"
 
 DEFINE_string(from, "", "hybrid mode: real EuRoC ASL folder whose IMU, ground truth and calibration are used");
+DEFINE_double(from_duration_s, 0.0, "hybrid mode: only the camera frames of the first S seconds of the sequence "
+              "(0: all) [s]");
 DEFINE_string(camera, "features", "camera output: features (features0/data.csv) or images (cam0/cam1 PNGs)");
 DEFINE_uint64(seed, 1, "seed of every random draw; same seed, byte-identical output");
 DEFINE_double(duration_s, 60.0, "synthetic flight length including the 3 s static start [s]");
@@ -88,6 +90,7 @@ SimulatorOptions OptionsFromFlags() {
   SimulatorOptions options;
   options.output_dir = FLAGS_output_dir;
   options.from_euroc_dir = FLAGS_from;
+  options.from_duration_s = FLAGS_from_duration_s;
   options.camera_output = ParseCameraOutput(FLAGS_camera);
   options.seed = FLAGS_seed;
   options.duration_s = FLAGS_duration_s;

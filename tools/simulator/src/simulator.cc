@@ -38,6 +38,10 @@ void CheckOptions(const SimulatorOptions& options) {
     throw std::invalid_argument("simulator: duration must be positive, got " +
                                 std::to_string(options.duration_s) + " s");
   }
+  if (!(options.from_duration_s >= 0.0)) {
+    throw std::invalid_argument("simulator: from_duration_s must be >= 0 (0: the whole sequence), got " +
+                                std::to_string(options.from_duration_s));
+  }
   CheckSensorOptions(options.sensor);
   CheckImageTextureOptions(options.textures);
   if (options.png_compression < 0 || options.png_compression > 9) {
@@ -114,7 +118,9 @@ void BuildHybridMotion(const SimulatorOptions& options, Simulation* sim) {
   dataset.root.clear();
   dataset.features.clear();
   dataset.has_images = false;
+  const Timestamp first_ns = dataset.frames[0].front().t_ns;
   for (const CameraFrame& row : dataset.frames[0]) {
+    if (options.from_duration_s > 0.0 && row.t_ns - first_ns > SecondsToNanos(options.from_duration_s)) break;
     if (const std::optional<Eigen::Isometry3d> T_w_b = InterpolatePose(dataset.groundtruth, row.t_ns)) {
       sim->frames.push_back({row.t_ns, *T_w_b});
     }

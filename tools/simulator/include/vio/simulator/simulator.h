@@ -41,6 +41,8 @@ struct SimulatorOptions {
   std::string output_dir;
   /// ASL folder of a real sequence for hybrid mode; empty = synthetic.
   std::string from_euroc_dir;
+  /// Hybrid mode: camera frames of the first this many seconds only (0: all) [s].
+  double from_duration_s = 0.0;
   /// What the cameras produce.
   SimCameraOutput camera_output = SimCameraOutput::kFeatures;
   /// Seed of every random draw (std::mt19937_64).
