@@ -311,6 +311,32 @@ TEST(EurocIo, SingleFileWritersRoundTrip) {
   ExpectSameImuCalibration(ReadImuYaml(dir + "/imu.yaml"), d.imu_calibration);
 }
 
+// vio run streams features0 one timestamp at a time: the groups are the
+// whole table's rows, in order, and ReadEuroc with stream_features keeps none.
+TEST(EurocIo, FeatureStreamGivesTheTableOneTimestampAtATime) {
+  const EurocDataset written = MakeSyntheticDataset();
+  const std::string root = test::MakeTempDir("euroc_feature_stream");
+  WriteEuroc(written, root);
+  FeatureCsvStream stream(root + "/mav0/features0/data.csv");
+  std::vector<FeatureObservation> streamed, group;
+  int groups = 0;
+  while (stream.Next(&group)) {
+    ASSERT_FALSE(group.empty());
+    for (const FeatureObservation& f : group) EXPECT_EQ(f.t_ns, group.front().t_ns);
+    EXPECT_TRUE(streamed.empty() || streamed.back().t_ns < group.front().t_ns);
+    streamed.insert(streamed.end(), group.begin(), group.end());
+    ++groups;
+  }
+  EXPECT_GT(groups, 1);
+  ExpectSameFeatures(streamed, written.features);
+
+  EurocReadOptions options;
+  options.stream_features = true;
+  const EurocDataset read = ReadEuroc(root, options);
+  EXPECT_TRUE(read.features.empty());
+  EXPECT_EQ(read.features_file, root + "/mav0/features0/data.csv");
+}
+
 TEST(EurocIo, FeaturesReaderSortsRowsOfOneTimestamp) {
   const std::string dir = test::MakeTempDir("euroc_features");
   WriteFile(dir + "/f.csv",

@@ -35,6 +35,7 @@ EurocDataset ReadRunDataset(const RunRequest& request) {
   }
   EurocReadOptions read;
   read.check_images = request.config.frontend.frontend != "features";
+  read.stream_features = true;  // read frame by frame in the run loop, never held whole
   EurocDataset dataset = ReadEuroc(request.dataset_dir, read);
   if (!request.config.calibration.calibration.empty()) {
     ApplyCalibrationFrom(request.config.calibration.calibration, &dataset);

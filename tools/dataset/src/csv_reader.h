@@ -8,6 +8,7 @@
 // Integers are parsed as integers (never through double), doubles with
 // std::from_chars (correctly rounded), so reading is fast and exact.
 #include <cstdint>
+#include <fstream>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -76,8 +77,8 @@ class CsvReader {
   std::string path_;
   std::vector<std::string> columns_;
   Separator separator_;
-  std::string text_;
-  std::size_t pos_ = 0;
+  std::ifstream in_;   ///< read line by line: a table is never held whole
+  std::string text_;  ///< the current line (fields_ view into it)
   int line_ = 0;
   int rows_ = 0;
   std::vector<std::string_view> fields_;

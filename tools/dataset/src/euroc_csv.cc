@@ -43,20 +43,6 @@ std::int64_t FractionToNanos(std::string_view digits) {
   return nanos;
 }
 
-std::string ReadWholeFile(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw DatasetError(path + ": cannot open (missing or not a file)");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw DatasetError(path + ": cannot open");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw DatasetError(path + ": read error");
-  constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
-  if (text.compare(0, kUtf8Bom.size(), kUtf8Bom) == 0) text.erase(0, kUtf8Bom.size());
-  return text;
-}
-
 }  // namespace
 
 DatasetError LineError(const std::string& path, int line, const std::string& what) {
@@ -98,19 +84,21 @@ bool ParseDecimalSecondsToNanos(std::string_view text, Timestamp* t_ns) {
 }
 
 CsvReader::CsvReader(std::string path, std::vector<std::string> columns, Separator separator)
-    : path_(std::move(path)),
-      columns_(std::move(columns)),
-      separator_(separator),
-      text_(ReadWholeFile(path_)) {
+    : path_(std::move(path)), columns_(std::move(columns)), separator_(separator) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path_, ec)) {
+    throw DatasetError(path_ + ": cannot open (missing or not a file)");
+  }
+  in_.open(path_, std::ios::binary);
+  if (!in_) throw DatasetError(path_ + ": cannot open");
   fields_.reserve(columns_.size());
 }
 
 bool CsvReader::NextRow() {
-  while (pos_ < text_.size()) {
-    std::size_t end = text_.find('\n', pos_);
-    if (end == std::string::npos) end = text_.size();
-    std::string_view line(text_.data() + pos_, end - pos_);
-    pos_ = end + 1;
+  while (std::getline(in_, text_)) {
+    std::string_view line(text_);
+    constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
+    if (line_ == 0 && line.substr(0, kUtf8Bom.size()) == kUtf8Bom) line.remove_prefix(kUtf8Bom.size());
     ++line_;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     line = Trim(line);
@@ -123,6 +111,7 @@ bool CsvReader::NextRow() {
     ++rows_;
     return true;
   }
+  if (in_.bad()) throw DatasetError(path_ + ": read error");
   return false;
 }
 

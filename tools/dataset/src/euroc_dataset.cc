@@ -119,8 +119,17 @@ EurocDataset ReadEuroc(const std::string& root, const EurocReadOptions& options)
   if (options.read_groundtruth) dataset.groundtruth = ReadGroundTruth(folders.mav0);
   std::error_code ec;
   const std::string features = folders.mav0 + "/features0/data.csv";
-  if (options.read_features && fs::exists(features, ec))
-    dataset.features = ReadFeaturesCsv(features);
+  if (options.read_features && fs::exists(features, ec)) {
+    if (options.stream_features) {
+      FeatureCsvStream stream(features);
+      std::vector<FeatureObservation> group;
+      bool any = false;
+      while (stream.Next(&group)) any = true;
+      if (any) dataset.features_file = features;
+    } else {
+      dataset.features = ReadFeaturesCsv(features);
+    }
+  }
   return dataset;
 }
 

@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
+#include <utility>
 #include <tuple>
 
 #include "csv_reader.h"
@@ -104,27 +106,54 @@ void WriteCameraCsv(const std::vector<CameraFrame>& frames, const std::string& p
   out.Save();
 }
 
-std::vector<FeatureObservation> ReadFeaturesCsv(const std::string& path) {
-  CsvReader reader(path, FeatureColumns());
-  TimestampOrder order(/*allow_equal=*/true);
-  std::vector<std::pair<FeatureObservation, int>> rows;  // observation, line
-  while (reader.NextRow()) {
-    rows.emplace_back(ReadFeatureRow(reader), reader.line());
-    order.Check(reader, rows.back().first.t_ns);
+struct FeatureCsvStream::Reader {
+  explicit Reader(const std::string& path) : csv(path, FeatureColumns()) {}
+
+  // The next row into `pending`; false at the end.
+  bool ReadRow() {
+    pending.reset();
+    if (!csv.NextRow()) return false;
+    pending.emplace(ReadFeatureRow(csv), csv.line());
+    order.Check(csv, pending->first.t_ns);
+    return true;
   }
-  std::stable_sort(rows.begin(), rows.end(), [](const auto& a, const auto& b) {
-    return SortKey(a.first) < SortKey(b.first);
-  });
-  std::vector<FeatureObservation> features;
-  features.reserve(rows.size());
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    if (i > 0 && SortKey(rows[i].first) == SortKey(rows[i - 1].first)) {
-      throw LineError(path, rows[i].second,
-                      "duplicated observation " + KeyText(rows[i].first) + " (also on line " +
-                          std::to_string(rows[i - 1].second) + ")");
+
+  CsvReader csv;
+  TimestampOrder order{/*allow_equal=*/true};
+  std::optional<std::pair<FeatureObservation, int>> pending;  ///< read, not yet returned (observation, line)
+  std::vector<std::pair<FeatureObservation, int>> rows;
+};
+
+FeatureCsvStream::FeatureCsvStream(const std::string& path) : reader_(std::make_unique<Reader>(path)) {}
+
+FeatureCsvStream::~FeatureCsvStream() = default;
+
+bool FeatureCsvStream::Next(std::vector<FeatureObservation>* group) {
+  group->clear();
+  Reader& r = *reader_;
+  if (!r.pending && !r.ReadRow()) return false;
+  r.rows.clear();
+  const Timestamp t_ns = r.pending->first.t_ns;
+  do {
+    r.rows.push_back(*r.pending);
+  } while (r.ReadRow() && r.pending->first.t_ns == t_ns);
+  std::stable_sort(r.rows.begin(), r.rows.end(),
+                   [](const auto& a, const auto& b) { return SortKey(a.first) < SortKey(b.first); });
+  for (std::size_t i = 0; i < r.rows.size(); ++i) {
+    if (i > 0 && SortKey(r.rows[i].first) == SortKey(r.rows[i - 1].first)) {
+      throw LineError(r.csv.path(), r.rows[i].second,
+                      "duplicated observation " + KeyText(r.rows[i].first) + " (also on line " +
+                          std::to_string(r.rows[i - 1].second) + ")");
     }
-    features.push_back(rows[i].first);
+    group->push_back(r.rows[i].first);
   }
+  return true;
+}
+
+std::vector<FeatureObservation> ReadFeaturesCsv(const std::string& path) {
+  FeatureCsvStream stream(path);
+  std::vector<FeatureObservation> features, group;
+  while (stream.Next(&group)) features.insert(features.end(), group.begin(), group.end());
   return features;
 }
 

@@ -1,5 +1,6 @@
 #include "vio/dataset/frame_source.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
@@ -20,7 +21,18 @@ bool HasImageFiles(const std::string& root) {
          std::filesystem::directory_iterator(folder, ec) != std::filesystem::directory_iterator();
 }
 
-// The `features` front end: features0/data.csv rectified up front.
+// The counts of summary.json's "frontend" object for the features source.
+std::string FeaturesReportJson(const StereoFramesReport& r) {
+  std::ostringstream os;
+  os << "{\"source\": \"features\", \"frames\": " << r.frames << ", \"stereo_observations\": "
+     << r.stereo_observations << ", \"left_only\": " << r.left_only << ", \"right_only\": " << r.right_only
+     << ", \"rejected_epipolar\": " << r.rejected_epipolar << ", \"rejected_disparity\": " << r.rejected_disparity
+     << ", \"rejected_outside_image\": " << r.rejected_outside_image << ", \"unrectifiable\": " << r.unrectifiable
+     << ", \"observations_off_frames\": " << r.observations_off_frames << "}";
+  return os.str();
+}
+
+// The `features` front end on features held in memory: rectified up front.
 class FeaturesSource final : public FrameSource {
  public:
   FeaturesSource(const EurocDataset& dataset, const frontend::StereoRectifier& rectifier, double max_epipolar_px)
@@ -30,28 +42,62 @@ class FeaturesSource final : public FrameSource {
   size_t size() const override { return frames_.size(); }
   Timestamp time(size_t k) const override { return frames_[k].t_ns; }
   StereoFrame Frame(size_t k, const Estimator&) override { return frames_[k]; }
-
-  std::string ReportJson() const override {
-    const StereoFramesReport& r = report_;
-    std::ostringstream os;
-    os << "{\"source\": \"features\", \"frames\": " << r.frames << ", \"stereo_observations\": "
-       << r.stereo_observations << ", \"left_only\": " << r.left_only << ", \"right_only\": " << r.right_only
-       << ", \"rejected_epipolar\": " << r.rejected_epipolar << ", \"rejected_disparity\": " << r.rejected_disparity
-       << ", \"rejected_outside_image\": " << r.rejected_outside_image << ", \"unrectifiable\": " << r.unrectifiable << ", \"observations_off_frames\": "
-       << r.observations_off_frames << "}";
-    return os.str();
-  }
+  std::string ReportJson() const override { return FeaturesReportJson(report_); }
 
  private:
   StereoFramesReport report_;
   std::vector<StereoFrame> frames_;
 };
 
+// The `features` front end streaming features0/data.csv: each frame's rows are
+// read and rectified when the frame is asked for (inside the run's timing).
+// Rows of stamps that are no cam0 frame are counted as off frames; rows of
+// frames the run skipped, and after the last frame asked for, are not read.
+class FeatureStreamSource final : public FrameSource {
+ public:
+  FeatureStreamSource(const EurocDataset& dataset, const frontend::StereoRectifier& rectifier,
+                      double max_epipolar_px)
+      : stream_(dataset.features_file), rectifier_(rectifier), max_epipolar_px_(max_epipolar_px) {
+    for (const CameraFrame& frame : dataset.frames[0]) times_.push_back(frame.t_ns);
+    report_.frames = static_cast<int>(times_.size());
+  }
+
+  size_t size() const override { return times_.size(); }
+  Timestamp time(size_t k) const override { return times_[k]; }
+
+  StereoFrame Frame(size_t k, const Estimator&) override {
+    const Timestamp t_ns = times_[k];
+    while (pending_ || (pending_ = stream_.Next(&group_))) {
+      const Timestamp group_t_ns = group_.front().t_ns;
+      if (group_t_ns > t_ns) break;
+      pending_ = false;
+      if (group_t_ns == t_ns) return StereoFrameFromFeatures(t_ns, group_, rectifier_, max_epipolar_px_, &report_);
+      if (!std::binary_search(times_.begin(), times_.end(), group_t_ns)) {
+        report_.observations_off_frames += static_cast<int>(group_.size());
+      }
+    }
+    StereoFrame empty;
+    empty.t_ns = t_ns;
+    return empty;
+  }
+
+  std::string ReportJson() const override { return FeaturesReportJson(report_); }
+
+ private:
+  FeatureCsvStream stream_;
+  const frontend::StereoRectifier& rectifier_;
+  const double max_epipolar_px_;
+  std::vector<Timestamp> times_;
+  std::vector<FeatureObservation> group_;
+  bool pending_ = false;  ///< group_ read and not yet used
+  StereoFramesReport report_;
+};
+
 }  // namespace
 
 std::string ResolveFrontend(const std::string& frontend, const EurocDataset& dataset) {
   if (frontend != "auto") return frontend;
-  if (!dataset.features.empty()) return "features";
+  if (!dataset.features.empty() || !dataset.features_file.empty()) return "features";
   if (dataset.has_images) {
     LOG(INFO) << dataset.root << ": no mav0/features0/data.csv, running the klt front end on the images "
               << "(--frontend=features|brisk|klt overrides)";
@@ -64,6 +110,9 @@ std::string ResolveFrontend(const std::string& frontend, const EurocDataset& dat
 std::unique_ptr<FrameSource> MakeFrameSource(const FrontendOptions& options, const EurocDataset& dataset,
                                              const frontend::StereoRectifier& rectifier) {
   if (options.frontend != "features") return MakeImageFrameSource(options, dataset, rectifier);
+  if (!dataset.features_file.empty()) {
+    return std::make_unique<FeatureStreamSource>(dataset, rectifier, options.max_epipolar_px);
+  }
   if (dataset.features.empty()) {
     const std::string images_hint =
         HasImageFiles(dataset.root) ? "; it has images: run an image front end with --frontend=brisk or --frontend=klt" : "";

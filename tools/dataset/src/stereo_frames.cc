@@ -36,6 +36,17 @@ void AddStereoObservations(const std::map<std::int64_t, PixelPair>& rows,
 
 }  // namespace
 
+StereoFrame StereoFrameFromFeatures(Timestamp t_ns, const std::vector<FeatureObservation>& features,
+                                    const frontend::StereoRectifier& rectifier, double max_epipolar_px,
+                                    StereoFramesReport* report) {
+  std::map<std::int64_t, PixelPair> rows;
+  for (const FeatureObservation& obs : features) rows[obs.feature_id].uv[obs.camera] = obs.uv_px;
+  StereoFrame frame;
+  frame.t_ns = t_ns;
+  AddStereoObservations(rows, rectifier, max_epipolar_px, &frame, report);
+  return frame;
+}
+
 std::vector<StereoFrame> StereoFramesFromFeatures(const std::vector<FeatureObservation>& features,
                                                   const std::vector<CameraFrame>& cam0_frames,
                                                   const frontend::StereoRectifier& rectifier,

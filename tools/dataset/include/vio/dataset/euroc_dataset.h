@@ -18,6 +18,7 @@
 // Read*(Write*(x)) == x exactly.
 #include <optional>
 #include <stdexcept>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,8 @@ struct EurocDataset {
   std::string image_topics[2];
   std::vector<GroundTruthState> groundtruth;
   std::vector<FeatureObservation> features;  ///< features0, sorted by (t, camera, id)
+  /// features0/data.csv when it was checked but not kept (EurocReadOptions::stream_features)
+  std::string features_file;
 };
 
 /// What to read; parts not asked for are left empty.
@@ -90,6 +93,9 @@ struct EurocReadOptions {
   bool check_images = true;
   bool read_groundtruth = true;
   bool read_features = true;      ///< features0/data.csv when present
+  /// With read_features: features0 is checked row by row but not kept (`features`
+  /// stays empty, `features_file` names it when it has rows; FeatureCsvStream reads it).
+  bool stream_features = false;
 };
 
 /// Reads an ASL sequence folder (the one holding mav0/, or mav0/ itself).
@@ -123,6 +129,24 @@ void WriteCameraCsv(const std::vector<CameraFrame>& frames, const std::string& p
 /// Rows sorted by (t, camera, feature_id); an empty table (header only) is allowed.
 std::vector<FeatureObservation> ReadFeaturesCsv(const std::string& path);
 void WriteFeaturesCsv(const std::vector<FeatureObservation>& features, const std::string& path);
+
+/// features0/data.csv one timestamp at a time (the file is sorted by time),
+/// with ReadFeaturesCsv's checks, never holding the whole table.
+class FeatureCsvStream {
+ public:
+  /// Throws DatasetError when the file cannot be opened.
+  explicit FeatureCsvStream(const std::string& path);
+  ~FeatureCsvStream();
+  FeatureCsvStream(const FeatureCsvStream&) = delete;
+  FeatureCsvStream& operator=(const FeatureCsvStream&) = delete;
+  /// The next timestamp's observations sorted by (camera, feature_id); false
+  /// at the end. Throws DatasetError "<path>:<line>: ..." on a malformed row.
+  bool Next(std::vector<FeatureObservation>* group);
+
+ private:
+  struct Reader;
+  std::unique_ptr<Reader> reader_;
+};
 CameraCalibration ReadCameraYaml(const std::string& path);
 void WriteCameraYaml(const CameraCalibration& camera, const std::string& path);
 ImuCalibration ReadImuYaml(const std::string& path);

@@ -22,6 +22,12 @@ struct StereoFramesReport {
   int observations_off_frames = 0; ///< feature rows whose stamp is no cam0 frame
 };
 
+/// The StereoFrame of stamp t_ns from that stamp's features (both cameras);
+/// adds to `report`'s observation counts.
+StereoFrame StereoFrameFromFeatures(Timestamp t_ns, const std::vector<FeatureObservation>& features,
+                                    const frontend::StereoRectifier& rectifier, double max_epipolar_px,
+                                    StereoFramesReport* report);
+
 /// One StereoFrame per cam0 frame stamp (empty frames included), observations
 /// sorted by landmark id.
 std::vector<StereoFrame> StereoFramesFromFeatures(const std::vector<FeatureObservation>& features,
