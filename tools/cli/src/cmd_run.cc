@@ -28,7 +28,7 @@ int RunMain(const std::vector<std::string>& args) {
   const RunResult result = RunDataset(request);
   std::cout << "status " << result.status << ": " << result.frames_estimated << "/" << result.frames
             << " frames, " << result.ms_per_frame << " ms per frame, " << result.real_time_factor
-            << "x real time\n";
+            << "x real time, peak memory " << result.peak_memory_mb << " MB\n";
   if (result.evaluation) std::cout << ToText(*result.evaluation);
   std::cout << "results in " << request.output_dir << "\n";
   for (const std::string& problem : result.problems) std::cerr << "vio run: " << problem << "\n";

@@ -302,7 +302,8 @@ RunResult RunDataset(const RunRequest& requested) {
   Evaluate(dataset, request, output, &result);
   output.WriteTrajectory();
   output.WriteTiming();
-  output.WriteSummary(result, source->ReportJson(), request, PeakMemoryMb(), estimator.waiting_reason());
+  result.peak_memory_mb = PeakMemoryMb();
+  output.WriteSummary(result, source->ReportJson(), request, result.peak_memory_mb, estimator.waiting_reason());
   output.WriteConfig(RunConfigToYaml(request.config));
   return result;
 }

@@ -52,6 +52,7 @@ struct RunResult {
   double processing_s = 0;       ///< wall time of the estimator loop [s]
   double ms_per_frame = 0;       ///< mean over estimated frames [ms]
   double real_time_factor = 0;   ///< dataset_duration_s / processing_s
+  double peak_memory_mb = 0;     ///< peak resident set size of the process (getrusage) [MiB]
   RunHealth health;
   std::optional<double> groundtruth_tilt_deg;  ///< tilt of the ground truth's z from up (decides the alignment)
   int frame_gaps = 0;             ///< frame intervals longer than 1.5 median intervals (missing frames)
