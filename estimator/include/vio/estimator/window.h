@@ -161,6 +161,9 @@ class Window {
   int num_priors() const { return static_cast<int>(priors_.size()); }
   const WindowHealth& health() const { return health_; }
   ceres::Problem& problem() { return *problem_; }
+  /// The Gauss-Newton column layout: variable blocks in id order, states
+  /// then landmarks tied by a prior (dense); the other landmarks eliminated.
+  GaussNewtonLayout Layout() const;
 
  private:
   struct ImuEdge {
@@ -185,9 +188,6 @@ class Window {
   std::vector<double*> Blocks(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks);
   SolveReport GaussNewton(int max_steps, bool until_converged, const SolverOptions& options);
   SolveReport LevenbergMarquardt(const ceres::Solver::Options& base, const SolverOptions& options);
-  /// Variable blocks in id order: states, then landmarks tied by a prior
-  /// (dense); the other landmarks are eliminated.
-  GaussNewtonLayout Layout() const;
   std::set<const double*> BlocksInPriors() const;
   /// Every residual block: priors in creation order, IMU factors and
   /// observations by ids (never by address).
