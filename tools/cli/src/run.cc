@@ -190,6 +190,11 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
         break;
       }
       output.AddFrame(estimate);
+      if (request.output_covariance) {
+        if (const std::optional<StateCovariance> covariance = estimator.NewestCovariance()) {
+          output.AddCovariance(*covariance);
+        }
+      }
       ++result->frames_estimated;
     } catch (const std::exception& e) {
       StopAt(k, source.size(), "failed",
@@ -264,6 +269,9 @@ void Evaluate(const EurocDataset& dataset, const RunRequest& request, const RunO
   EvaluationOptions options;
   options.alignment = SummaryAlignment(dataset, request.config.estimator.model.gravity, result);
   result->evaluation = EvaluateTrajectory(output.trajectory(), dataset.groundtruth, options);
+  if (request.output_covariance) {
+    result->nees = EvaluateNees(output.trajectory(), dataset.groundtruth, output.PoseCovariances(), options);
+  }
   const std::vector<GroundTruthState>& estimated = output.trajectory();
   CheckDrift(*result->evaluation,
              PathLength(dataset.groundtruth, estimated.front().t_ns, estimated.back().t_ns), result);
@@ -303,6 +311,8 @@ RunResult RunDataset(const RunRequest& requested) {
   output.WriteTiming();
   output.WriteSummary(result, source->ReportJson(), request, PeakMemoryMb(), estimator.waiting_reason());
   output.WriteConfig(RunConfigToYaml(request.config));
+  if (request.output_covariance) output.WriteCovariance();
+  if (result.nees) output.WriteNees(*result.nees);
   return result;
 }
 
