@@ -193,6 +193,15 @@ def plot_errors(dataset, runs, out_path):
     plt.close(fig)
 
 
+def finish(fig, ax, out_path):
+    """Grid, legend outside, saved and closed."""
+    ax.grid(True, which="major", alpha=0.3)
+    legend_outside(ax)
+    fig.tight_layout()
+    fig.savefig(out_path, dpi=DPI)
+    plt.close(fig)
+
+
 def plot_ate_vs_cost(rows, styles, out_path):
     """One line per (dataset, policy) through its window sizes; each point has its run's colour
     and marker and is labelled w=N."""
@@ -233,11 +242,7 @@ def plot_ate_vs_cost(rows, styles, out_path):
     where = datasets[0] if len(datasets) == 1 else f"{len(datasets)} datasets"
     ax.set_title(f"{where}: accuracy against cost (w = window size [frames]; lower left is better)\n"
                  f"ATE after position + yaw alignment", fontsize=11)
-    ax.grid(True, which="major", alpha=0.3)
-    legend_outside(ax)
-    fig.tight_layout()
-    fig.savefig(out_path, dpi=DPI)
-    plt.close(fig)
+    finish(fig, ax, out_path)
     return True
 
 
@@ -265,11 +270,7 @@ def plot_nees(nees_dir, rows, styles, out_path):
     ax.set_xlabel("time since the first frame every run estimated [s]")
     ax.set_ylabel("pose NEES, mean over the seeds (log scale)")
     ax.set_title("Consistency: pose NEES (6 dof) over time, after position + yaw alignment")
-    ax.grid(True, which="major", alpha=0.3)
-    legend_outside(ax)
-    fig.tight_layout()
-    fig.savefig(out_path, dpi=DPI)
-    plt.close(fig)
+    finish(fig, ax, out_path)
     return True
 
 
