@@ -9,6 +9,9 @@ position + yaw alignment, with its position error), and writes:
                                       and a zoom on the stretch where the runs are furthest apart
   plots/position_error_<dataset>.png  position error over time, one line per run
   plots/ate_vs_cost.png               ATE RMSE against estimator time per frame, per policy and window
+  plots/nees.png                      (Monte Carlo sweeps, plots/data/nees/<policy>_<window>.csv) the
+                                      pose NEES over time, mean over the seeds, per configuration, with
+                                      its 95% chi-square band
   report.md                           the results table and every plot in one page
 
 Every run keeps one colour, marker and line style in all plots (colour per run, marker and
@@ -190,6 +193,15 @@ def plot_errors(dataset, runs, out_path):
     plt.close(fig)
 
 
+def finish(fig, ax, out_path):
+    """Grid, legend outside, saved and closed."""
+    ax.grid(True, which="major", alpha=0.3)
+    legend_outside(ax)
+    fig.tight_layout()
+    fig.savefig(out_path, dpi=DPI)
+    plt.close(fig)
+
+
 def plot_ate_vs_cost(rows, styles, out_path):
     """One line per (dataset, policy) through its window sizes; each point has its run's colour
     and marker and is labelled w=N."""
@@ -230,11 +242,35 @@ def plot_ate_vs_cost(rows, styles, out_path):
     where = datasets[0] if len(datasets) == 1 else f"{len(datasets)} datasets"
     ax.set_title(f"{where}: accuracy against cost (w = window size [frames]; lower left is better)\n"
                  f"ATE after position + yaw alignment", fontsize=11)
-    ax.grid(True, which="major", alpha=0.3)
-    legend_outside(ax)
-    fig.tight_layout()
-    fig.savefig(out_path, dpi=DPI)
-    plt.close(fig)
+    finish(fig, ax, out_path)
+    return True
+
+
+def plot_nees(nees_dir, rows, styles, out_path):
+    """Run-mean pose NEES over time per configuration, the 95% band of a consistent estimator
+    and the 6 it should average to; log scale (over-confident runs are orders of magnitude off)."""
+    runs = []
+    for key in dict.fromkeys(run_key(row) for row in rows):
+        path = os.path.join(nees_dir, f"{key[0]}_{key[1]}.csv")
+        if os.path.exists(path):
+            runs.append((run_label(*key), styles[key], read_columns(path)))
+    if not runs:
+        return False
+    fig, ax = plt.subplots(figsize=(10, 4.6))
+    band = runs[0][2]
+    ax.fill_between(band["t_s"], band["lower"], band["upper"], color="0.8", alpha=0.6, lw=0,
+                    label="95% bounds (consistent)")
+    ax.axhline(6.0, color="0.35", lw=1.0, ls=":", label="6 (pose dof)")
+    for label, style, run in runs:
+        ax.plot(run["t_s"], run["nees_pose"], lw=1.2, label=label, **line_style(style, len(run)))
+    values = np.concatenate([run["nees_pose"] for _, _, run in runs] + [band["lower"], band["upper"]])
+    positive = values[values > 0]
+    ax.set_yscale("log")
+    label_log_axis(ax.yaxis, positive.min(), positive.max())
+    ax.set_xlabel("time since the first frame every run estimated [s]")
+    ax.set_ylabel("pose NEES, mean over the seeds (log scale)")
+    ax.set_title("Consistency: pose NEES (6 dof) over time, after position + yaw alignment")
+    finish(fig, ax, out_path)
     return True
 
 
@@ -243,11 +279,12 @@ def write_report(sweep_dir, rows, written):
     results_md = os.path.join(sweep_dir, "results.md")
     table = open(results_md).read().rstrip() + "\n" if os.path.exists(results_md) else ""
     lines = [table, "## Plots", ""]
-    captions = {"trajectories": "Top view", "position_error": "Position error over time"}
+    captions = {"trajectories": "Top view", "position_error": "Position error over time",
+                "nees": "Pose NEES over time"}
     for path in written:
         name = os.path.splitext(os.path.basename(path))[0]
-        caption = next((f"{text}: {name[len(key) + 1:]}" for key, text in captions.items()
-                        if name.startswith(key + "_")), "ATE against time per frame")
+        caption = captions.get(name) or next((f"{text}: {name[len(key) + 1:]}" for key, text in captions.items()
+                                              if name.startswith(key + "_")), "ATE against time per frame")
         lines += [f"### {caption}", "", f"![{caption}](plots/{os.path.basename(path)})", ""]
     not_ok = [row for row in rows if row["status"] != "ok"]
     if not_ok:
@@ -280,8 +317,15 @@ def main():
         path = os.path.join(plots_dir, f"position_error_{dataset}.png")
         plot_errors(dataset, runs, path)
         written.append(path)
+    nees_dir = os.path.join(plots_dir, "data", "nees")
+    monte_carlo = os.path.isdir(nees_dir)
     path = os.path.join(plots_dir, "ate_vs_cost.png")
-    if plot_ate_vs_cost(rows, styles, path):
+    # A Monte Carlo sweep: one line per configuration is enough (the first seed).
+    first = [row for row in rows if row["dataset"] == rows[0]["dataset"]] if monte_carlo else rows
+    if plot_ate_vs_cost(first, styles, path):
+        written.append(path)
+    path = os.path.join(plots_dir, "nees.png")
+    if monte_carlo and plot_nees(nees_dir, rows, styles, path):
         written.append(path)
     report = write_report(args.sweep_dir, rows, written)
     print(f"{len(written)} PNGs in {plots_dir}: " + ", ".join(os.path.basename(p) for p in written) +

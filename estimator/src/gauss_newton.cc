@@ -201,39 +201,70 @@ double SquaredNorm(const ceres::Problem& problem, const std::vector<double*>& bl
   return sum;
 }
 
-}  // namespace
+/// The linearized system at the current values with the eliminated blocks
+/// Schur-complemented out: H dx_dense = -b over the dense columns.
+struct Linearization {
+  double cost = 0;
+  int dense_dim = 0;
+  int num_cols = 0;
+  std::vector<double*> parameter_blocks;  ///< dense, then eliminated
+  std::vector<EliminatedBlock> blocks;
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+};
 
-GaussNewtonStep TakeGaussNewtonStep(ceres::Problem* problem, const GaussNewtonLayout& layout) {
-  GaussNewtonStep step;
+bool Linearize(ceres::Problem* problem, const GaussNewtonLayout& layout, Linearization* out) {
   ceres::Problem::EvaluateOptions evaluate;
   evaluate.residual_blocks = layout.residuals;
   evaluate.parameter_blocks = layout.dense;
   evaluate.parameter_blocks.insert(evaluate.parameter_blocks.end(), layout.eliminated.begin(),
                                    layout.eliminated.end());
   // An empty list would mean every block.
-  if (evaluate.parameter_blocks.empty() || evaluate.residual_blocks.empty()) return step;
+  if (evaluate.parameter_blocks.empty() || evaluate.residual_blocks.empty()) return false;
   std::vector<double> r;
   ceres::CRSMatrix J;
-  if (!problem->Evaluate(evaluate, &step.cost, &r, nullptr, &J)) return step;
+  if (!problem->Evaluate(evaluate, &out->cost, &r, nullptr, &J)) return false;
 
-  int dense_dim = 0;
-  for (const double* block : layout.dense) dense_dim += TangentSize(*problem, block);
-  std::vector<EliminatedBlock> blocks(layout.eliminated.size());
-  int col = dense_dim;
-  for (size_t k = 0; k < blocks.size(); ++k) {
-    blocks[k].offset = col;
-    blocks[k].size = TangentSize(*problem, layout.eliminated[k]);
-    col += blocks[k].size;
+  out->parameter_blocks = evaluate.parameter_blocks;
+  out->num_cols = J.num_cols;
+  out->dense_dim = 0;
+  for (const double* block : layout.dense) out->dense_dim += TangentSize(*problem, block);
+  out->blocks.assign(layout.eliminated.size(), EliminatedBlock());
+  int col = out->dense_dim;
+  for (size_t k = 0; k < out->blocks.size(); ++k) {
+    out->blocks[k].offset = col;
+    out->blocks[k].size = TangentSize(*problem, layout.eliminated[k]);
+    col += out->blocks[k].size;
   }
-  NormalEquationsBuilder builder(J, r, dense_dim, &blocks);
+  NormalEquationsBuilder builder(J, r, out->dense_dim, &out->blocks);
   builder.Build();
-  EliminateBlocks(blocks, builder.H(), builder.b());
+  EliminateBlocks(out->blocks, builder.H(), builder.b());
+  out->H = std::move(builder.H());
+  out->b = std::move(builder.b());
+  return true;
+}
 
-  Eigen::VectorXd dx = Eigen::VectorXd::Zero(J.num_cols);
+}  // namespace
+
+bool ReducedNormalEquations(ceres::Problem* problem, const GaussNewtonLayout& layout, ReducedSystem* system) {
+  Linearization linearization;
+  if (!Linearize(problem, layout, &linearization)) return false;
+  system->H = std::move(linearization.H);
+  system->b = std::move(linearization.b);
+  return true;
+}
+
+GaussNewtonStep TakeGaussNewtonStep(ceres::Problem* problem, const GaussNewtonLayout& layout) {
+  GaussNewtonStep step;
+  Linearization lin;
+  if (!Linearize(problem, layout, &lin)) return step;
+  step.cost = lin.cost;
+
+  Eigen::VectorXd dx = Eigen::VectorXd::Zero(lin.num_cols);
   Eigen::VectorXd dx_dense;
-  if (!SolveDense(builder.H(), builder.b(), &dx_dense)) return step;
-  dx.head(dense_dim) = dx_dense;
-  for (const EliminatedBlock& block : blocks) {
+  if (!SolveDense(lin.H, lin.b, &dx_dense)) return step;
+  dx.head(lin.dense_dim) = dx_dense;
+  for (const EliminatedBlock& block : lin.blocks) {
     Eigen::VectorXd rhs = block.b;
     for (size_t p = 0; p < block.dense_cols.size(); ++p) {
       rhs += block.W.row(static_cast<Eigen::Index>(p)).transpose() * dx_dense[block.dense_cols[p]];
@@ -242,10 +273,10 @@ GaussNewtonStep TakeGaussNewtonStep(ceres::Problem* problem, const GaussNewtonLa
   }
   if (!dx.allFinite()) return step;
 
-  step.values_norm = std::sqrt(SquaredNorm(*problem, evaluate.parameter_blocks));
+  step.values_norm = std::sqrt(SquaredNorm(*problem, lin.parameter_blocks));
   step.step_norm = dx.norm();
   ApplyStep(problem, layout.dense, dx, 0);
-  ApplyStep(problem, layout.eliminated, dx, dense_dim);
+  ApplyStep(problem, layout.eliminated, dx, lin.dense_dim);
   step.ok = true;
   return step;
 }

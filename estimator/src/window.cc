@@ -58,6 +58,7 @@ Window::Window(const ModelOptions& model, const RectifiedStereo& stereo)
   options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_ = std::make_unique<ceres::Problem>(options);
+  if (model_.fej) first_estimates_ = std::make_shared<FirstEstimates>();
 }
 
 Window::~Window() = default;
@@ -101,8 +102,10 @@ void Window::AddImuResidual(ImuEdge& edge) {
   State& a = state(edge.from);
   State& b = state(edge.to);
   const Eigen::Vector3d g_w(0, 0, -model_.gravity);
-  edge.residual = problem_->AddResidualBlock(Wrap(ImuFactor::Create(edge.preintegration, g_w)), nullptr,
-                                             a.pose, a.speed_bias, b.pose, b.speed_bias);
+  ceres::CostFunction* factor = WithFirstEstimates(
+      Wrap(ImuFactor::Create(edge.preintegration, g_w)),
+      {BlockKey::Pose(a.id), BlockKey::SpeedBias(a.id), BlockKey::Pose(b.id), BlockKey::SpeedBias(b.id)});
+  edge.residual = problem_->AddResidualBlock(factor, nullptr, a.pose, a.speed_bias, b.pose, b.speed_bias);
 }
 
 void Window::AddStatePrior(StateId id, const StatePrior& prior) {
@@ -113,13 +116,18 @@ void Window::AddStatePrior(StateId id, const StatePrior& prior) {
       covariance.solve(Eigen::Matrix<double, 6, 6>::Identity()));
   CHECK(information.info() == Eigen::Success) << "state prior information is not positive definite";
   const Eigen::Matrix<double, 6, 6> sqrt_information = information.matrixU();
-  Prior pose_prior{problem_->AddResidualBlock(PosePriorFactor::Create(s.p_w_b(), s.q_w_b(), sqrt_information),
-                                              nullptr, s.pose),
+  HoldFirstEstimates({s.pose, s.speed_bias});
+  Prior pose_prior{problem_->AddResidualBlock(
+                       WithFirstEstimates(PosePriorFactor::Create(s.p_w_b(), s.q_w_b(), sqrt_information),
+                                          {BlockKey::Pose(id)}),
+                       nullptr, s.pose),
                    {s.pose}};
   const Eigen::Matrix<double, 9, 1> sigma = prior.speed_bias_sigma;
   Prior sb_prior{problem_->AddResidualBlock(
-                     SpeedBiasPriorFactor::Create(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(s.speed_bias),
-                                                  sigma.cwiseInverse().asDiagonal().toDenseMatrix()),
+                     WithFirstEstimates(
+                         SpeedBiasPriorFactor::Create(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(s.speed_bias),
+                                                      sigma.cwiseInverse().asDiagonal().toDenseMatrix()),
+                         {BlockKey::SpeedBias(id)}),
                      nullptr, s.speed_bias),
                  {s.speed_bias}};
   priors_.push_back(pose_prior);
@@ -143,7 +151,9 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
   CHECK(observations_.count(key) == 0) << "landmark " << landmark_id.value << " observed twice in state "
                                       << state_id.value;
   ceres::ResidualBlockId residual = problem_->AddResidualBlock(
-      Wrap(StereoFactor::Create(z_px, stereo_, model_.pixel_sigma)), loss_.get(), s.pose, it->second.p_w);
+      WithFirstEstimates(Wrap(StereoFactor::Create(z_px, stereo_, model_.pixel_sigma)),
+                         {BlockKey::Pose(state_id), BlockKey::Landmark(landmark_id)}),
+      loss_.get(), s.pose, it->second.p_w);
   observations_[key] = Observation{z_px, residual};
   it->second.observed_from.insert(state_id);
 }
@@ -222,6 +232,9 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   if (blocks.empty()) return;
   marginalization::MarginalizationOptions options;
   options.residual_order = ResidualOrder();
+  if (first_estimates_) {
+    options.first_estimate = [this](const double* block) { return first_estimates_->Find(KeyOf(block)); };
+  }
   std::set<const double*> removed(blocks.begin(), blocks.end());
   ForgetResidualsOf(removed);
   const std::set<ceres::ResidualBlockId> dropped = DropUnevaluableResiduals(blocks);
@@ -233,6 +246,7 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
     std::vector<double*> kept;
     problem_->GetParameterBlocksForResidualBlock(prior, &kept);
     priors_.push_back(Prior{prior, {kept.begin(), kept.end()}});
+    HoldFirstEstimates(kept);
   }
   for (StateId id : state_ids) RemoveStateBookkeeping(id);
   for (LandmarkId id : landmark_ids) landmarks_.erase(id);

@@ -120,7 +120,7 @@ bool MarginalizationPrior::LocalCoordinates(int i, const double* x, double* delt
 bool MarginalizationPrior::MinusTangentJacobian(int i, const double* x, Eigen::MatrixXd* T) const {
   const Block& block = blocks_[i];
   const int n = tangent_sizes_[i];
-  if (block.manifold == nullptr || std::equal(block.x0.begin(), block.x0.end(), x)) {
+  if (block.manifold == nullptr || jacobian_at_x0_ || std::equal(block.x0.begin(), block.x0.end(), x)) {
     *T = Eigen::MatrixXd::Identity(n, n);
     return true;
   }

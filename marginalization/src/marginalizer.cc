@@ -204,6 +204,30 @@ std::vector<MarginalizationPrior::Block> PriorBlocks(const ceres::Problem& probl
   return blocks;
 }
 
+/// FEJ: x0_i <- x_fe_i and r0 <- r0 + Jp_i (x_fe_i ⊟ x_i) for every kept block
+/// with a first estimate.
+void ReexpressAtFirstEstimates(const ceres::Problem& problem, const std::vector<double*>& kept,
+                               const std::function<const double*(const double*)>& first_estimate,
+                               const Eigen::MatrixXd& sqrt_information,
+                               std::vector<MarginalizationPrior::Block>* blocks, Eigen::VectorXd* residual) {
+  int offset = 0;
+  for (size_t i = 0; i < kept.size(); ++i) {
+    const int tangent = problem.ParameterBlockTangentSize(kept[i]);
+    MarginalizationPrior::Block& block = (*blocks)[i];
+    if (const double* first = first_estimate(kept[i])) {
+      Eigen::VectorXd delta(tangent);
+      if (block.manifold != nullptr) {
+        CHECK(block.manifold->Minus(first, kept[i], delta.data()));
+      } else {
+        for (int k = 0; k < tangent; ++k) delta[k] = first[k] - kept[i][k];
+      }
+      *residual += sqrt_information.middleCols(offset, tangent) * delta;
+      block.x0.assign(first, first + block.x0.size());
+    }
+    offset += tangent;
+  }
+}
+
 /// Steps 2-4 of the header: linearize, Schur-complement, take the square root.
 std::unique_ptr<MarginalizationPrior> BuildPrior(ceres::Problem* problem,
                                                  const MarkovBlanket& blanket,
@@ -225,8 +249,15 @@ std::unique_ptr<MarginalizationPrior> BuildPrior(ceres::Problem* problem,
   if (sqrt.sqrt_information.rows() == 0) {
     return nullptr;
   }
-  return MarginalizationPrior::Create(PriorBlocks(*problem, blanket.kept),
-                                      std::move(sqrt.sqrt_information), std::move(sqrt.residual));
+  std::vector<MarginalizationPrior::Block> blocks = PriorBlocks(*problem, blanket.kept);
+  if (options.first_estimate) {
+    ReexpressAtFirstEstimates(*problem, blanket.kept, options.first_estimate, sqrt.sqrt_information, &blocks,
+                              &sqrt.residual);
+  }
+  std::unique_ptr<MarginalizationPrior> prior = MarginalizationPrior::Create(
+      std::move(blocks), std::move(sqrt.sqrt_information), std::move(sqrt.residual));
+  if (options.first_estimate) prior->HoldJacobianAtLinearizationPoint();
+  return prior;
 }
 
 }  // namespace

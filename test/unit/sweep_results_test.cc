@@ -116,9 +116,10 @@ TEST(SweepResults, CsvHasOneRowPerRunAndEmptyFieldsForMissingNumbers) {
   EXPECT_FALSE(std::getline(lines, extra));
   EXPECT_EQ(header,
             "dataset,policy,window,status,exit_code,ate_rmse_m,rpe_1m_trans_pct,rpe_1m_rot_deg_per_m,"
-            "rpe_10m_trans_pct,rpe_10m_rot_deg_per_m,ms_per_frame,real_time_factor,peak_memory_mb,message,run_dir");
-  EXPECT_EQ(ok_row.rfind("V2_01,swf,10,ok,0,0.0204,1.25,0.5,,,6.125,8.5,190.25,,/", 0), 0u) << ok_row;
-  EXPECT_EQ(failed_row.rfind("V2_01,msckf,5,failed,1,,,,,,,,,vio run: error: --policy: 'msckf' is not one of swf,/", 0),
+            "rpe_10m_trans_pct,rpe_10m_rot_deg_per_m,ms_per_frame,real_time_factor,peak_memory_mb,nees_pose,"
+            "nees_position,nees_orientation,message,run_dir");
+  EXPECT_EQ(ok_row.rfind("V2_01,swf,10,ok,0,0.0204,1.25,0.5,,,6.125,8.5,190.25,,,,,/", 0), 0u) << ok_row;
+  EXPECT_EQ(failed_row.rfind("V2_01,msckf,5,failed,1,,,,,,,,,,,,vio run: error: --policy: 'msckf' is not one of swf,/", 0),
             0u)
       << failed_row;
 }

@@ -1,8 +1,10 @@
-// `vio eval`: trajectory error (ATE, RPE) of an estimate against ground truth.
+// `vio eval`: trajectory error (ATE, RPE) of an estimate against ground truth,
+// and with --covariance its consistency (NEES).
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -11,6 +13,7 @@
 #include <gflags/gflags.h>
 
 #include "commands.h"
+#include "vio/evaluation/nees.h"
 #include "vio/evaluation/trajectory_eval.h"
 
 DEFINE_string(estimate, "", "estimated trajectory, TUM text: t[s] x y z qx qy qz qw per line");
@@ -20,6 +23,10 @@ DEFINE_string(alignment, "posyaw", "estimate-to-ground-truth alignment: posyaw|s
 DEFINE_string(rpe_lengths, "1,2,5,10",
               "RPE sub-trajectory lengths along the ground truth [m], comma separated");
 DEFINE_string(json, "", "also write the report as JSON to this file (optional; vio verify: its rows)");
+DEFINE_string(covariance, "",
+              "covariance.csv of the run (vio run --output_covariance): adds the NEES of position, orientation and "
+              "pose after the same alignment (optional)");
+DEFINE_string(nees_csv, "", "with --covariance: per-frame NEES file; empty = nees.csv next to the covariance file");
 DEFINE_double(max_gt_gap_s, 0,
               "ground truth is not interpolated across gaps longer than this; estimates inside are skipped; "
               "0 = 10 median ground-truth sample intervals (EuRoC: 0.05 s) [s] valid: [0, inf)");
@@ -31,6 +38,8 @@ struct EvalRequest {
   std::string estimate_path;
   std::string groundtruth_path;
   std::string json_path;  ///< empty: no JSON
+  std::string covariance_path;  ///< empty: no NEES
+  std::string nees_path;        ///< per-frame NEES (with covariance_path)
   EvaluationOptions options;
 };
 
@@ -65,6 +74,15 @@ EvalRequest RequestFromFlags(const std::vector<std::string>& args) {
   request.estimate_path = FLAGS_estimate;
   request.groundtruth_path = FLAGS_groundtruth;
   request.json_path = FLAGS_json;
+  request.covariance_path = FLAGS_covariance;
+  if (!FLAGS_covariance.empty()) {
+    if (!std::filesystem::is_regular_file(FLAGS_covariance)) {
+      throw std::invalid_argument("--covariance: file not found: " + FLAGS_covariance);
+    }
+    request.nees_path = FLAGS_nees_csv.empty()
+                            ? (std::filesystem::path(FLAGS_covariance).parent_path() / "nees.csv").string()
+                            : FLAGS_nees_csv;
+  }
   request.options.alignment = ParseAlignment(FLAGS_alignment);
   request.options.rpe_lengths_m = ParseLengths(FLAGS_rpe_lengths);
   if (!(FLAGS_max_gt_gap_s >= 0.0) || !std::isfinite(FLAGS_max_gt_gap_s)) {
@@ -74,10 +92,13 @@ EvalRequest RequestFromFlags(const std::vector<std::string>& args) {
   return request;
 }
 
-void WriteJson(const TrajectoryEvaluation& evaluation, const std::string& path) {
+void WriteJson(const TrajectoryEvaluation& evaluation, const std::optional<NeesResult>& nees,
+               const std::string& path) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path);
-  out << ToJson(evaluation) << "\n";
+  std::string json = ToJson(evaluation);
+  if (nees) json.insert(json.rfind("\n}"), ",\n  \"nees\": " + NeesJson(*nees));
+  out << json << "\n";
   if (!out) throw std::runtime_error("error writing " + path);
 }
 
@@ -89,8 +110,17 @@ void RunEval(const EvalRequest& request) {
             << "groundtruth " << request.groundtruth_path << " (" << groundtruth.size()
             << " samples)\n"
             << ToText(evaluation);
+  std::optional<NeesResult> nees;
+  if (!request.covariance_path.empty()) {
+    nees = EvaluateNees(estimate, groundtruth, ReadCovarianceCsv(request.covariance_path), request.options);
+    std::cout << "NEES        " << nees->samples.size() << " frames with a covariance: position "
+              << nees->mean_position << " (3 dof), orientation " << nees->mean_orientation << " (3 dof), pose "
+              << nees->mean_pose << " (6 dof)\n";
+    WriteNeesCsv(*nees, request.nees_path);
+    std::cout << "nees        " << request.nees_path << "\n";
+  }
   if (!request.json_path.empty()) {
-    WriteJson(evaluation, request.json_path);
+    WriteJson(evaluation, nees, request.json_path);
     std::cout << "json        " << request.json_path << "\n";
   }
 }

@@ -7,6 +7,9 @@
 #include "vio/cli/run.h"
 
 DEFINE_string(dataset, "", "EuRoC ASL dataset folder (holding mav0/) with features0/data.csv or images");
+DEFINE_bool(output_covariance, false,
+            "write covariance.csv: per frame, the newest state's marginal covariance (pose 6x6 upper triangle, "
+            "velocity and bias variances) from the window's information");
 DEFINE_string(config, "", "run configuration YAML (e.g. config/euroc_stereo.yaml); flags override it");
 
 namespace vio::tools {
@@ -25,6 +28,7 @@ int RunMain(const std::vector<std::string>& args) {
   request.dataset_dir = FLAGS_dataset;
   request.output_dir = FLAGS_output_dir;
   request.config = LoadRunConfig(FLAGS_config);
+  request.output_covariance = FLAGS_output_covariance;
   const RunResult result = RunDataset(request);
   std::cout << "status " << result.status << ": " << result.frames_estimated << "/" << result.frames
             << " frames, " << result.ms_per_frame << " ms per frame, " << result.real_time_factor

@@ -18,6 +18,13 @@ DEFINE_string(window_sizes, "10", "window sizes to sweep, comma separated (passe
 DEFINE_string(runs, "",
               "explicit policy:window pairs instead of --policies x --window_sizes, e.g. "
               "swf:5,swf:10,msckf:10,ekf:1,batch:10");
+DEFINE_int32(seeds, 0,
+             "Monte Carlo: simulate this many datasets that differ only in their noise (vio simulate "
+             "--noise_seed=1..N with --simulate_flags) instead of --datasets; every run writes its covariance and "
+             "NEES; results.md gets ANEES with 95% chi-square bounds, plots/nees.png the NEES over time");
+DEFINE_string(simulate_flags, "",
+              "with --seeds: `vio simulate` flags of the Monte Carlo datasets, e.g. \"--duration_s=20\" or "
+              "\"--from=EUROC_DIR\"");
 DEFINE_int32(jobs, 1, "runs at a time (each run is its own process)");
 DEFINE_string(extra_flags, "", "further `vio run` flags for every run, e.g. \"--init=groundtruth --max_iterations=5\"");
 DEFINE_bool(emit_jobs, false, "only write OUTPUT_DIR/jobs.txt, one shell line per run (GNU parallel, Slurm, k8s)");
@@ -112,6 +119,21 @@ SweepRequest RequestFromFlags(const std::vector<std::string>& args) {
   for (const std::string& flag : SplitFlags(FLAGS_extra_flags)) request.run_flags.push_back(flag);
   request.jobs = FLAGS_jobs;
   if (request.jobs < 1) throw std::invalid_argument("--jobs must be >= 1");
+  request.seeds = FLAGS_seeds;
+  if (request.seeds < 0) throw std::invalid_argument("--seeds must be >= 0");
+  request.simulate_flags = SplitFlags(FLAGS_simulate_flags);
+  if (request.seeds > 0) {
+    if (!request.datasets.empty()) throw std::invalid_argument("--seeds simulates its datasets: drop --datasets");
+    for (const std::string& flag : request.simulate_flags) {
+      if (flag.rfind("--output_dir", 0) == 0 || flag.rfind("--noise_seed", 0) == 0) {
+        throw std::invalid_argument("--simulate_flags: '" + flag + "' is set by the sweep for every seed");
+      }
+    }
+    request.run_flags.push_back("--output_covariance=true");
+    request.datasets = SimulateSeedDatasets(request, std::cout);
+  } else if (!request.simulate_flags.empty()) {
+    throw std::invalid_argument("--simulate_flags needs --seeds");
+  }
   if (!request.config_path.empty() && !std::filesystem::is_regular_file(request.config_path)) {
     throw std::invalid_argument("--config: file not found: " + request.config_path);
   }

@@ -191,6 +191,11 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
         break;
       }
       output.AddFrame(estimate);
+      if (request.output_covariance) {
+        if (const std::optional<StateCovariance> covariance = estimator.NewestCovariance()) {
+          output.AddCovariance(*covariance);
+        }
+      }
       ++result->frames_estimated;
     } catch (const std::exception& e) {
       StopAt(k, source.size(), "failed",
@@ -265,6 +270,9 @@ void Evaluate(const EurocDataset& dataset, const RunRequest& request, const RunO
   EvaluationOptions options;
   options.alignment = SummaryAlignment(dataset, request.config.estimator.model.gravity, result);
   result->evaluation = EvaluateTrajectory(output.trajectory(), dataset.groundtruth, options);
+  if (request.output_covariance) {
+    result->nees = EvaluateNees(output.trajectory(), dataset.groundtruth, output.PoseCovariances(), options);
+  }
   const std::vector<GroundTruthState>& estimated = output.trajectory();
   CheckDrift(*result->evaluation,
              PathLength(dataset.groundtruth, estimated.front().t_ns, estimated.back().t_ns), result);
@@ -305,6 +313,8 @@ RunResult RunDataset(const RunRequest& requested) {
   result.peak_memory_mb = PeakMemoryMb();
   output.WriteSummary(result, source->ReportJson(), request, result.peak_memory_mb, estimator.waiting_reason());
   output.WriteConfig(RunConfigToYaml(request.config));
+  if (request.output_covariance) output.WriteCovariance();
+  if (result.nees) output.WriteNees(*result.nees);
   return result;
 }
 

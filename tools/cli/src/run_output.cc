@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "json_writer.h"
+#include "vio/estimator/pose_manifold.h"
 
 namespace vio::tools {
 namespace {
@@ -127,8 +128,39 @@ void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_jso
     }
     out << ",\n  \"evaluation\": " << evaluation;
   }
+  if (r.nees) out << ",\n  \"nees\": " << NeesJson(*r.nees);
   out << "\n}\n";
 }
+
+void RunOutput::AddCovariance(const StateCovariance& covariance) { covariances_.push_back(covariance); }
+
+void RunOutput::WriteCovariance() const {
+  std::ofstream out = OpenForWriting(dir_ + "/covariance.csv");
+  out << "#t_ns";
+  for (int r = 0; r < kPoseTangentSize; ++r) {
+    for (int c = r; c < kPoseTangentSize; ++c) out << ",pose_" << r << "_" << c;
+  }
+  out << ",var_vx,var_vy,var_vz,var_bgx,var_bgy,var_bgz,var_bax,var_bay,var_baz\n";
+  out << std::setprecision(10);
+  for (const StateCovariance& s : covariances_) {
+    out << s.t_ns;
+    for (int r = 0; r < kPoseTangentSize; ++r) {
+      for (int c = r; c < kPoseTangentSize; ++c) out << "," << s.covariance(r, c);
+    }
+    for (int k = kPoseTangentSize; k < kStateTangentSize; ++k) out << "," << s.covariance(k, k);
+    out << "\n";
+  }
+}
+
+std::vector<PoseCovariance> RunOutput::PoseCovariances() const {
+  std::vector<PoseCovariance> poses;
+  for (const StateCovariance& s : covariances_) {
+    poses.push_back({s.t_ns, s.covariance.topLeftCorner<kPoseTangentSize, kPoseTangentSize>()});
+  }
+  return poses;
+}
+
+void RunOutput::WriteNees(const NeesResult& nees) const { WriteNeesCsv(nees, dir_ + "/nees.csv"); }
 
 void RunOutput::WriteConfig(const std::string& yaml) const { OpenForWriting(dir_ + "/config.yaml") << yaml; }
 

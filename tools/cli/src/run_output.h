@@ -26,11 +26,22 @@ class RunOutput {
   void WriteSummary(const RunResult& result, const std::string& frontend_json, const RunRequest& request,
                     double peak_memory_mb, const std::string& waiting_reason) const;
   void WriteConfig(const std::string& yaml) const;
+  /// covariance.csv, one row per frame with a covariance:
+  ///   #t_ns, then the upper triangle of the 6x6 pose covariance row by row
+  ///   (pose_r_c, r <= c, over [dp_x dp_y dp_z (world, m), dth_x dth_y dth_z
+  ///   (body, rad)]: 21 columns), then the variances of v_w_b (m/s)^2, b_g
+  ///   (rad/s)^2, b_a (m/s^2)^2 (9 columns).
+  void AddCovariance(const StateCovariance& covariance);
+  void WriteCovariance() const;
+  /// The pose blocks of the covariances added so far.
+  std::vector<PoseCovariance> PoseCovariances() const;
+  void WriteNees(const NeesResult& nees) const;
 
  private:
   std::string dir_;
   std::vector<GroundTruthState> trajectory_;
   std::vector<FrameEstimate> frames_;
+  std::vector<StateCovariance> covariances_;
 };
 
 }  // namespace vio::tools

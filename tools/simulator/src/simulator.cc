@@ -221,9 +221,11 @@ std::array<CameraCalibration, 2> EurocStereoCalibration() {
 Simulation BuildSimulation(const SimulatorOptions& options) {
   CheckOptions(options);
   std::mt19937_64 rng(options.seed);
+  std::mt19937_64 own_noise_rng(options.noise_seed);
+  std::mt19937_64* noise_rng = options.noise_seed != 0 ? &own_noise_rng : &rng;
   Simulation sim;
   if (options.from_euroc_dir.empty()) {
-    BuildSyntheticMotion(options, &rng, &sim);
+    BuildSyntheticMotion(options, noise_rng, &sim);
   } else {
     BuildHybridMotion(options, &sim);
   }
@@ -235,7 +237,7 @@ Simulation BuildSimulation(const SimulatorOptions& options) {
   sim.scene = BuildScene(options.scene, PathOf(sim.dataset.groundtruth), &rng);
   if (options.camera_output == SimCameraOutput::kFeatures) {
     sim.features = SimulateFeatures(sim.scene, {sim.dataset.cameras[0], sim.dataset.cameras[1]}, sim.frames,
-                                    options.features, &rng);
+                                    options.features, noise_rng);
     BlackOutFeatures(options.gaps.blackouts, first_frame_ns, &sim);
     sim.dataset.features = sim.features.observations;
   }

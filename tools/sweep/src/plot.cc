@@ -4,6 +4,9 @@
 // plots/data/<dataset>/groundtruth.csv   t_s,x_m,y_m,z_m (t from the first ground-truth sample)
 // plots/data/<dataset>/<policy>_<w>.csv  t_s,x_m,y_m,z_m,error_m: the estimate after
 //                                        position + yaw alignment, and |p_est - p_gt|
+// plots/data/nees/<policy>_<w>.csv       (Monte Carlo) t_s,nees_pose,lower,upper: the
+//                                        run-mean pose NEES per frame and its 95% bounds
+// Monte Carlo sweeps plot the trajectories of the first seed only.
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -74,12 +77,30 @@ int WriteDatasetPlotData(const std::vector<const SweepResult*>& runs, const std:
   return written;
 }
 
+// plots/data/nees/: one file per configuration with NEES.
+void WriteNeesPlotData(const std::vector<SweepResult>& results, const std::string& plots_dir) {
+  for (const MonteCarloSummary& s : SummarizeMonteCarlo(results)) {
+    if (s.nees_over_time.empty()) continue;
+    std::ofstream out = OpenCsv(plots_dir + "/data/nees/" + s.policy + "_" + std::to_string(s.window_size) + ".csv",
+                                "t_s,nees_pose,lower,upper");
+    for (const auto& [t_s, nees] : s.nees_over_time) {
+      out << t_s << "," << nees << "," << s.lower_pose << "," << s.upper_pose << "\n";
+    }
+  }
+}
+
 // Writes plots/data; returns the number of runs with a trajectory there.
-int WritePlotData(const std::vector<SweepResult>& results, const std::string& plots_dir) {
+int WritePlotData(const SweepRequest& request, const std::vector<SweepResult>& results,
+                  const std::string& plots_dir) {
   std::map<std::string, std::vector<const SweepResult*>> by_dataset;
-  for (const SweepResult& r : results) by_dataset[r.run.dataset_name].push_back(&r);
+  for (const SweepResult& r : results) {
+    if (request.seeds == 0 || r.run.dataset_name == results.front().run.dataset_name) {
+      by_dataset[r.run.dataset_name].push_back(&r);
+    }
+  }
   std::error_code ec;
   fs::remove_all(plots_dir + "/data", ec);
+  if (request.seeds > 0) WriteNeesPlotData(results, plots_dir);
   int written = 0;
   for (const auto& [name, runs] : by_dataset) {
     try {
@@ -111,7 +132,7 @@ std::string FindPlotScript(const std::string& vio_binary) {
 std::string MakePlots(const SweepRequest& request, const std::vector<SweepResult>& results,
                       const std::string& python, const std::string& plot_script) {
   const std::string plots_dir = fs::absolute(request.output_dir).lexically_normal().string() + "/plots";
-  const int runs_with_data = WritePlotData(results, plots_dir);
+  const int runs_with_data = results.empty() ? 0 : WritePlotData(request, results, plots_dir);
   if (runs_with_data == 0) return "plots skipped: no run has a trajectory to plot";
   if (!fs::exists(python)) {
     return "plots skipped: " + python + " not found (plots need Python 3 with numpy and matplotlib; " +

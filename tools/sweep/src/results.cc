@@ -9,6 +9,7 @@
 
 #include "internal.h"
 #include "json.h"
+#include "vio/evaluation/nees.h"
 #include "vio/sweep/sweep.h"
 
 namespace vio::tools {
@@ -60,6 +61,11 @@ void ReadSummary(const std::string& path, SweepResult* result) {
   result->peak_memory_mb = NumberOf(summary, "peak_memory_mb");
   if (const JsonValue* reason = summary.Find("not_initialized_reason")) result->message = reason->string;
   if (const JsonValue* evaluation = summary.Find("evaluation")) ReadEvaluation(*evaluation, result);
+  if (const JsonValue* nees = summary.Find("nees")) {
+    result->nees_pose = NumberOf(*nees, "pose");
+    result->nees_position = NumberOf(*nees, "position");
+    result->nees_orientation = NumberOf(*nees, "orientation");
+  }
 }
 
 std::string Fixed(double value, int digits) {
@@ -152,7 +158,7 @@ std::string ResultsCsv(const std::vector<SweepResult>& results) {
   const std::vector<double> lengths = RpeLengths(results);
   std::string csv = "dataset,policy,window,status,exit_code,ate_rmse_m";
   for (double l : lengths) csv += ",rpe_" + Exact(l) + "m_trans_pct,rpe_" + Exact(l) + "m_rot_deg_per_m";
-  csv += ",ms_per_frame,real_time_factor,peak_memory_mb,message,run_dir\n";
+  csv += ",ms_per_frame,real_time_factor,peak_memory_mb,nees_pose,nees_position,nees_orientation,message,run_dir\n";
   for (const SweepResult& r : results) {
     csv += r.run.dataset_name + "," + r.run.policy + "," + std::to_string(r.run.window_size) + "," + r.status +
            "," + (r.exit_code >= 0 ? std::to_string(r.exit_code) : "") + "," + Exact(r.ate_rmse_m);
@@ -161,6 +167,7 @@ std::string ResultsCsv(const std::vector<SweepResult>& results) {
       csv += "," + (rpe ? Exact(rpe->trans_pct) : "") + "," + (rpe ? Exact(rpe->rot_deg_per_m) : "");
     }
     csv += "," + Exact(r.ms_per_frame) + "," + Exact(r.real_time_factor) + "," + Exact(r.peak_memory_mb) + "," +
+           Exact(r.nees_pose) + "," + Exact(r.nees_position) + "," + Exact(r.nees_orientation) + "," +
            CsvField(r.message) + "," + CsvField(r.run.run_dir) + "\n";
   }
   return csv;
@@ -201,6 +208,15 @@ void WriteResults(const SweepRequest& request, const std::vector<SweepResult>& r
      << "ATE: RMSE of the position error after position + yaw alignment. RPE: mean translation error over\n"
         "sub-trajectories of the given length travelled, in % of the length. ms/frame: estimator time per frame.\n\n"
      << ResultsMarkdown(results) << FailureNotes(results);
+  if (request.seeds > 0) {
+    const ChiSquareBounds bounds = AneesBounds95(6, request.seeds);
+    md << "\n## Monte Carlo: " << request.seeds << " noise seeds per configuration\n\n"
+       << "ANEES: mean NEES over runs and frames (pose error [p_gt - p, Log(R^T R_gt)] after position + yaw\n"
+          "alignment, covariance from the window's information). A consistent estimator has ANEES = dof; the\n"
+          "run-mean NEES at one frame of N consistent runs lies within chi2(6N)/N's 95% bounds ([" << bounds.lower
+       << ", " << bounds.upper << "] for N = " << request.seeds << ", Wilson-Hilferty) 95% of the time.\n\n"
+       << MonteCarloMarkdown(SummarizeMonteCarlo(results));
+  }
   if (!md) throw std::runtime_error(md_path + ": cannot write");
 }
 

@@ -13,6 +13,7 @@
 #include "vio/estimator/policy.h"
 #include "vio/estimator/tracking_monitor.h"
 #include "vio/estimator/window.h"
+#include "vio/estimator/window_covariance.h"
 
 namespace vio {
 
@@ -60,6 +61,10 @@ class Estimator {
   std::optional<Eigen::Isometry3d> PredictBodyPose(Timestamp t_ns) const;
 
   const Window& window() const { return window_; }
+  /// The newest state's marginal covariance from the window's information
+  /// at the current estimate (window_covariance.h); nothing before
+  /// initialization or when the information is singular.
+  std::optional<StateCovariance> NewestCovariance() { return NewestStateCovariance(window_); }
   /// Frames lost to too few observations (propagated on the IMU).
   const TrackingReport& tracking() const { return tracking_.report(); }
   /// Why static initialization has not happened yet (empty once initialized).

@@ -143,6 +143,7 @@ struct ModelOptions {
   double reintegrate_bias_threshold = 0.01;  ///< re-preintegrate when the gyro bias moved [rad/s]
   double max_whitened_residual = 50.0;  ///< observations of window landmarks predicted worse are rejected [sigma]
   double max_imu_gap_s = 0.1;          ///< longest IMU gap the estimate bridges; a longer one ends the run [s]
+  bool fej = false;  ///< first-estimate Jacobians on every block in a prior (first_estimates.h)
 
   template <class V>
   void Visit(V& v) {
@@ -162,6 +163,9 @@ struct ModelOptions {
       "longest gap between IMU samples the estimate bridges; at a longer one the run stops (status imu_gap) and "
       "frames outside the IMU's span by more than this are reported (status frames_skipped) [s]",
       Positive());
+    v("fej", fej,
+      "first-estimate Jacobians: every factor's Jacobians on a block in a prior are taken at the value the block had "
+      "when it entered its first prior (keeps yaw and position unobservable, as they are)");
   }
 };
 

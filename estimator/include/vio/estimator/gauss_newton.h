@@ -14,6 +14,8 @@
 
 #include <ceres/problem.h>
 
+#include <Eigen/Core>
+
 namespace vio {
 
 /// Which variable parameter blocks the step solves for, in column order.
@@ -32,6 +34,19 @@ struct GaussNewtonStep {
   double step_norm = 0;    ///< |dx| on the tangent space
   double values_norm = 0;  ///< |x| of the blocks before the step (ambient values)
 };
+
+/// The Gauss-Newton system at the current values with the eliminated blocks
+/// Schur-complemented out: H dx = -b over the layout's dense columns (in
+/// layout order, tangent spaces). H is the window's information about the
+/// dense blocks.
+struct ReducedSystem {
+  Eigen::MatrixXd H;  ///< J^T J reduced to the dense columns
+  Eigen::VectorXd b;  ///< J^T r reduced to the dense columns
+};
+
+/// Linearizes as TakeGaussNewtonStep does, without stepping; false when the
+/// layout is empty or evaluation fails.
+bool ReducedNormalEquations(ceres::Problem* problem, const GaussNewtonLayout& layout, ReducedSystem* system);
 
 /// Takes one undamped Gauss-Newton step on the blocks of `layout`; every
 /// other block is held at its value.

@@ -18,6 +18,7 @@
 #include <ceres/ceres.h>
 
 #include "vio/estimator/estimator_options.h"
+#include "vio/estimator/first_estimates.h"
 #include "vio/estimator/gauss_newton.h"
 #include "vio/estimator/imu_preintegration.h"
 #include "vio/estimator/types.h"
@@ -161,6 +162,9 @@ class Window {
   int num_priors() const { return static_cast<int>(priors_.size()); }
   const WindowHealth& health() const { return health_; }
   ceres::Problem& problem() { return *problem_; }
+  /// The Gauss-Newton column layout: variable blocks in id order, states
+  /// then landmarks tied by a prior (dense); the other landmarks eliminated.
+  GaussNewtonLayout Layout() const;
 
  private:
   struct ImuEdge {
@@ -185,9 +189,6 @@ class Window {
   std::vector<double*> Blocks(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks);
   SolveReport GaussNewton(int max_steps, bool until_converged, const SolverOptions& options);
   SolveReport LevenbergMarquardt(const ceres::Solver::Options& base, const SolverOptions& options);
-  /// Variable blocks in id order: states, then landmarks tied by a prior
-  /// (dense); the other landmarks are eliminated.
-  GaussNewtonLayout Layout() const;
   std::set<const double*> BlocksInPriors() const;
   /// Every residual block: priors in creation order, IMU factors and
   /// observations by ids (never by address).
@@ -198,6 +199,14 @@ class Window {
   void ForgetResidualsOf(const std::set<const double*>& removed_blocks);
   std::set<ceres::ResidualBlockId> DropUnevaluableResiduals(const std::vector<double*>& blocks);
   void RemoveStateBookkeeping(StateId id);
+  /// FEJ (model.fej): `factor` wrapped to take its Jacobians on held blocks at
+  /// their first estimates; `factor` itself without FEJ.
+  ceres::CostFunction* WithFirstEstimates(ceres::CostFunction* factor, std::vector<BlockKey> keys) const;
+  /// FEJ: holds the blocks of a new prior at their current values (blocks with
+  /// a first estimate keep it).
+  void HoldFirstEstimates(const std::vector<double*>& blocks);
+  /// The key of a state or landmark block of the window.
+  BlockKey KeyOf(const double* block) const;
 
   ModelOptions model_;
   RectifiedStereo stereo_;
@@ -209,6 +218,7 @@ class Window {
   std::map<StateId, ImuEdge> imu_edges_;  ///< keyed by the later state (`to`)
   std::map<ObservationKey, Observation> observations_;
   std::vector<Prior> priors_;
+  std::shared_ptr<FirstEstimates> first_estimates_;  ///< model.fej: the held blocks; else null
   Removals removals_;
   WindowHealth health_;
   FactorWrapper wrapper_;

@@ -61,6 +61,13 @@ class MarginalizationPrior final : public ceres::CostFunction {
   const Eigen::MatrixXd& sqrt_information() const { return sqrt_information_; }
   /// r0: the residual at the linearization point.
   const Eigen::VectorXd& residual_at_x0() const { return residual_at_x0_; }
+  /// The linearization point x0 of block i (AmbientSize values).
+  const std::vector<double>& linearization_point(int i) const { return blocks_[i].x0; }
+  /// First-estimate Jacobians: from now on the Jacobian is the one at x0 for
+  /// every block, Jp_i on the tangent (T_i = I), wherever x is; the residual
+  /// stays r0 + Jp (x ⊟ x0).
+  void HoldJacobianAtLinearizationPoint() { jacobian_at_x0_ = true; }
+  bool jacobian_at_linearization_point() const { return jacobian_at_x0_; }
   /// Column of block i in sqrt_information().
   int tangent_offset(int i) const { return tangent_offsets_[i]; }
   int tangent_size(int i) const { return tangent_sizes_[i]; }
@@ -81,6 +88,7 @@ class MarginalizationPrior final : public ceres::CostFunction {
   Eigen::VectorXd residual_at_x0_;
   std::vector<int> tangent_offsets_;
   std::vector<int> tangent_sizes_;
+  bool jacobian_at_x0_ = false;
 };
 
 }  // namespace vio::marginalization

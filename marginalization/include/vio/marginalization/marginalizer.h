@@ -19,6 +19,7 @@
 // current value); if it is made variable later the prior says nothing about
 // it. A constant block in `to_marginalize` is conditioned on, not integrated
 // out: its residuals still feed the prior on the blanket.
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -41,6 +42,13 @@ struct MarginalizationOptions {
   /// hold every residual block touching a marginalized block). Empty: the
   /// problem's order, which Ceres' block removal makes depend on addresses.
   std::vector<ceres::ResidualBlockId> residual_order;
+  /// First-estimate Jacobians (FEJ), when set: the first estimate of a kept
+  /// block (AmbientSize values), or nullptr when it has none. The prior is
+  /// linearized at the current values as always, then re-expressed at the
+  /// first estimates, x0_i = x_fe_i, r0 <- r0 + Jp_i (x_fe_i ⊟ x_i) (exact at
+  /// x_fe for the linear model), and holds its Jacobian at x0
+  /// (MarginalizationPrior::HoldJacobianAtLinearizationPoint).
+  std::function<const double*(const double* block)> first_estimate;
 };
 
 struct MarginalizationResult {

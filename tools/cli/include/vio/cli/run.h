@@ -8,12 +8,15 @@
 //   summary.json    counts (frame gaps, tracking loss), time per stage, real-time factor, peak memory,
 //                   ATE/RPE (when ground truth exists)
 //   config.yaml     the effective configuration
+//   covariance.csv  with output_covariance: per frame, the newest state's marginal covariance (run_output.h)
+//   nees.csv        with output_covariance and ground truth: per-frame NEES (nees.h), means in summary.json
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "vio/cli/run_config.h"
 #include "vio/estimator/tracking_monitor.h"
+#include "vio/evaluation/nees.h"
 #include "vio/evaluation/trajectory_eval.h"
 
 namespace vio::tools {
@@ -23,6 +26,7 @@ struct RunRequest {
   std::string output_dir;    ///< created when missing
   RunConfig config;
   bool show_progress = true; ///< progress bar (only drawn on a terminal)
+  bool output_covariance = false;  ///< write covariance.csv (one more linearization per frame)
 };
 
 /// What a run could not do or had to reject (summary.json "health").
@@ -59,6 +63,7 @@ struct RunResult {
   double longest_frame_gap_s = 0; ///< longest frame interval [s]
   TrackingReport tracking;        ///< frames with too few observations (propagated on the IMU)
   std::optional<TrajectoryEvaluation> evaluation;  ///< when ground truth exists
+  std::optional<NeesResult> nees;  ///< with output_covariance, when ground truth exists (same alignment)
 };
 
 /// Runs and writes the output folder. Throws DatasetError / ConfigError /

@@ -47,6 +47,11 @@ struct SimulatorOptions {
   SimCameraOutput camera_output = SimCameraOutput::kFeatures;
   /// Seed of every random draw (std::mt19937_64).
   std::uint64_t seed = 1;
+  /// Seed of the measurement noise alone (IMU noise and biases, feature
+  /// selection and pixel noise) when not 0: the trajectory and the scene
+  /// (from `seed`) stay the same, so runs with different noise seeds are
+  /// Monte Carlo realizations of one experiment. 0 = every draw from `seed`.
+  std::uint64_t noise_seed = 0;
   /// Synthetic flight length including the initial static period [s].
   double duration_s = 60.0;
   /// Room, clutter and landmarks.

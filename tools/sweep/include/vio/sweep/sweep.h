@@ -12,6 +12,14 @@
 //   jobs.txt                            (--emit_jobs) one shell line per run
 //   plots/                              PNGs (plot_sweep.py) and the data behind them
 //
+// Monte Carlo (seeds > 0): the datasets are `seeds` simulations of one
+// experiment that differ in their measurement noise only,
+//   datasets/seed_<k>/   `vio simulate --noise_seed=k SIMULATE_FLAGS` (k = 1..seeds;
+//                        a `done` marker as for runs: an unfinished one is redone)
+// every run writes its covariance (--output_covariance) and NEES, results.md
+// gets a table per configuration over the seeds (mean ATE, ANEES with its 95%
+// chi-square bounds) and plots/nees.png the NEES over time per configuration.
+//
 // A run that exits without a summary.json (unknown policy, bad flag, crash,
 // kill) is "failed" and is retried by the next sweep; a run that wrote its
 // summary (status ok, diverged or not_initialized) is finished and kept.
@@ -35,6 +43,8 @@ struct SweepRequest {
   std::string config_path;            ///< --config of every run; empty = none
   std::vector<std::string> run_flags; ///< further `vio run` flags, e.g. "--init=groundtruth"
   int jobs = 1;                       ///< runs at a time
+  int seeds = 0;                      ///< Monte Carlo realizations (noise seeds); 0 = the datasets as given
+  std::vector<std::string> simulate_flags;  ///< `vio simulate` flags of the Monte Carlo datasets
 };
 
 /// One combination of the sweep.
@@ -70,6 +80,9 @@ struct SweepResult {
   double ms_per_frame = kNaN;      ///< [ms]
   double real_time_factor = kNaN;  ///< dataset duration / processing time
   double peak_memory_mb = kNaN;    ///< peak resident memory of the run [MB]
+  double nees_pose = kNaN;         ///< mean pose NEES over the run's frames (6 dof)
+  double nees_position = kNaN;     ///< mean position NEES (3 dof)
+  double nees_orientation = kNaN;  ///< mean orientation NEES (3 dof)
   bool Ok() const { return status == "ok"; }
 };
 
@@ -122,6 +135,34 @@ std::string ProgressLine(const SweepResult& result, int index, int total);
 std::string ResultsCsv(const std::vector<SweepResult>& results);
 /// results.md: a Markdown table, one row per run.
 std::string ResultsMarkdown(const std::vector<SweepResult>& results);
+
+/// Monte Carlo: simulates the seed datasets that are not finished (one `vio
+/// simulate` process each, request.jobs at a time is not needed: they are
+/// short) and returns their folders, seed_01.. in order. Throws
+/// std::runtime_error naming the log of a simulation that failed.
+std::vector<std::string> SimulateSeedDatasets(const SweepRequest& request, std::ostream& progress);
+
+/// One configuration (policy, window) over the Monte Carlo runs.
+struct MonteCarloSummary {
+  std::string policy;
+  int window_size = 0;
+  int runs = 0;                    ///< runs with NEES (status ok)
+  double mean_ate_m = 0;           ///< mean over runs of the ATE RMSE [m]
+  double anees_pose = 0;           ///< mean pose NEES over runs and frames (6 dof)
+  double anees_position = 0;       ///< (3 dof)
+  double anees_orientation = 0;    ///< (3 dof)
+  double lower_pose = 0;           ///< 95% bounds of the mean over `runs` runs at one instant, 6 dof
+  double upper_pose = 0;
+  double fraction_in_bounds = 0;   ///< frames seen by every run whose run-mean pose NEES is within the bounds
+  /// Per frame seen by every run: time from the first such frame [s] and the run-mean pose NEES.
+  std::vector<std::pair<double, double>> nees_over_time;
+};
+
+/// Groups the results by (policy, window) and reads each ok run's nees.csv.
+std::vector<MonteCarloSummary> SummarizeMonteCarlo(const std::vector<SweepResult>& results);
+
+/// The Markdown table of SummarizeMonteCarlo.
+std::string MonteCarloMarkdown(const std::vector<MonteCarloSummary>& summaries);
 
 /// Writes jobs.txt (one JobCommand per line, plan order); returns its path.
 std::string WriteJobsFile(const SweepRequest& request);

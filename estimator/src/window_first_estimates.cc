@@ -1,0 +1,36 @@
+// Window's first-estimate Jacobians (model.fej; first_estimates.h): which
+// factors are wrapped and which blocks are held.
+#include <glog/logging.h>
+
+#include "vio/estimator/pose_manifold.h"
+#include "vio/estimator/window.h"
+
+namespace vio {
+
+ceres::CostFunction* Window::WithFirstEstimates(ceres::CostFunction* factor, std::vector<BlockKey> keys) const {
+  if (!first_estimates_) return factor;
+  std::vector<FejCostFunction::Parameter> parameters;
+  for (const BlockKey& key : keys) {
+    parameters.push_back({key, key.kind == BlockKey::Kind::kPose ? pose_manifold_.get() : nullptr});
+  }
+  return new FejCostFunction(factor, std::move(parameters), first_estimates_);
+}
+
+void Window::HoldFirstEstimates(const std::vector<double*>& blocks) {
+  if (!first_estimates_) return;
+  for (const double* block : blocks) first_estimates_->Hold(KeyOf(block), block, problem_->ParameterBlockSize(block));
+}
+
+BlockKey Window::KeyOf(const double* block) const {
+  for (const auto& [id, s] : states_) {
+    if (block == s.pose) return BlockKey::Pose(id);
+    if (block == s.speed_bias) return BlockKey::SpeedBias(id);
+  }
+  for (const auto& [id, landmark] : landmarks_) {
+    if (block == landmark.p_w) return BlockKey::Landmark(id);
+  }
+  LOG(FATAL) << "a parameter block that is neither a state nor a landmark of the window";
+  return {};
+}
+
+}  // namespace vio
