@@ -10,12 +10,12 @@
 #   --cache       where the generated datasets and the runs go (default
 #                 ${VIO_BENCH_CACHE:-/tmp/vio_bench}); datasets are reused when present
 #   --rendered_s  seconds of V2_01 rendered for the front-end rows (default 20)
-# Environment: EUROC (default /work/shared/data/euroc) holds V2_01_easy;
+# Environment: EUROC (default ../shared/data/euroc beside the repository) holds V2_01_easy;
 # BUILD_DIR (default build/) the Release build; the script builds `vio` there.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${BUILD_DIR:-$root/build}"
-euroc="${EUROC:-/work/shared/data/euroc}"
+euroc="${EUROC:-$root/../shared/data/euroc}"
 cache="${VIO_BENCH_CACHE:-/tmp/vio_bench}"
 rows="swf5,swf10,swf30,swf50,msckf10,ekf,keyframe,brisk,klt"
 rendered_s=20
