@@ -22,7 +22,12 @@ bool PathExists(const std::string& path);
 
 /// A fresh, empty temporary folder for one test (removed at exit is not
 /// guaranteed; it lives under the system temp dir).
+// A new, empty folder `<prefix>_<random>` inside this test process's own temporary root.
 std::string MakeTempDir(const std::string& prefix);
+
+// Removes the process's temporary root and everything in it, unless `keep`; returns the root's
+// path when it was kept (empty otherwise). test_main calls it after the tests.
+std::string RemoveTempRoot(bool keep);
 
 }  // namespace vio::test
 
