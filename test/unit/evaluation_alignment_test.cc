@@ -202,6 +202,43 @@ INSTANTIATE_TEST_SUITE_P(RollAndPitch, EvalPosYawTilt,
                          ::testing::Values(TiltCase{Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitX()},
                                            TiltCase{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY()}));
 
+// The first-pose alignment (the estimator's gauge): the estimate is the ground
+// truth moved by a known yaw and translation, its first pose also tilted and
+// displaced. posyaw puts the first position on the truth and leaves a pure tilt
+// (no rotation about z) in the first orientation; se3 puts the whole first pose on it.
+TEST(EvalAlignment, FirstPoseAlignmentPutsTheFirstPoseOnTheTruth) {
+  const std::vector<GroundTruthState> gt = Helix(20);
+  const Eigen::Isometry3d T_est_gt = MakeTransform(Rz(2.2), Eigen::Vector3d(0.4, -1.0, 0.3));
+  std::vector<GroundTruthState> est = Transformed(gt, 1.0, T_est_gt);
+  const Eigen::Quaterniond tilt(Eigen::AngleAxisd(0.05, Eigen::Vector3d(1.0, -0.5, 0.0).normalized()));
+  est.front().q_w_b = tilt * est.front().q_w_b;
+  est.front().p_w_b += Eigen::Vector3d(0.02, 0.01, -0.03);
+  const AssociatedTrajectory pairs = Associate(est, gt);
+
+  const AlignmentResult posyaw = AlignAtFirstPose(pairs, Alignment::kPosYaw);
+  const AssociatedTrajectory aligned = ApplyAlignment(pairs, posyaw);
+  EXPECT_LT((aligned.T_w_b_est[0].translation() - gt[0].p_w_b).norm(), 1e-12);
+  const Eigen::AngleAxisd error(Eigen::Matrix3d(aligned.T_w_b_gt[0].linear() * aligned.T_w_b_est[0].linear().transpose()));
+  EXPECT_NEAR(error.angle(), 0.05, 1e-12);
+  EXPECT_LT(std::abs(error.axis().z()), 1e-12) << "a rotation about z is left: " << error.axis().transpose();
+  const Eigen::Matrix3d& R = posyaw.T_gt_est.linear();
+  EXPECT_LT((R.col(2) - Eigen::Vector3d::UnitZ()).norm(), 1e-12) << "roll/pitch in\n" << R;
+  // The later poses (not displaced) are off only by the first pose's displacement.
+  EXPECT_LT((ApplyAlignment(pairs, AlignAtFirstPose(Associate(Transformed(gt, 1.0, T_est_gt), gt),
+                                                    Alignment::kPosYaw))
+                 .T_w_b_est[5]
+                 .matrix() -
+             aligned.T_w_b_gt[5].matrix())
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-12);
+
+  const AssociatedTrajectory se3 = ApplyAlignment(pairs, AlignAtFirstPose(pairs, Alignment::kSe3));
+  ExpectIsometryNear(se3.T_w_b_est[0], se3.T_w_b_gt[0], 1e-12);
+  EXPECT_EQ(AlignAtFirstPose(pairs, Alignment::kNone).T_gt_est.matrix(), Eigen::Matrix4d::Identity());
+  EXPECT_THROW(AlignAtFirstPose(AssociatedTrajectory{}, Alignment::kPosYaw), std::invalid_argument);
+}
+
 TEST(EvalAlignment, NoneIsTheIdentity) {
   const std::vector<GroundTruthState> gt = Helix(10);
   const AlignmentResult result =

@@ -25,7 +25,7 @@ DEFINE_string(rpe_lengths, "1,2,5,10",
 DEFINE_string(json, "", "also write the report as JSON to this file (optional; vio verify: its rows)");
 DEFINE_string(covariance, "",
               "covariance.csv of the run (vio run --output_covariance): adds the NEES of position, orientation and "
-              "pose after the same alignment (optional)");
+              "pose, the estimate aligned at its first pose along the directions --alignment frees (optional)");
 DEFINE_string(nees_csv, "", "with --covariance: per-frame NEES file; empty = nees.csv next to the covariance file");
 DEFINE_double(max_gt_gap_s, 0,
               "ground truth is not interpolated across gaps longer than this; estimates inside are skipped; "

@@ -129,6 +129,24 @@ AlignmentResult Align(const AssociatedTrajectory& trajectory, Alignment alignmen
   return AlignUmeyama(centered, alignment == Alignment::kSim3);
 }
 
+AlignmentResult AlignAtFirstPose(const AssociatedTrajectory& trajectory, Alignment alignment) {
+  if (trajectory.t_ns.empty()) throw std::invalid_argument("first-pose alignment needs an associated pose");
+  AlignmentResult result;
+  if (alignment == Alignment::kNone) return result;
+  const Eigen::Isometry3d& est = trajectory.T_w_b_est.front();
+  const Eigen::Isometry3d& gt = trajectory.T_w_b_gt.front();
+  if (alignment == Alignment::kPosYaw) {
+    // Swing-twist: q = swing * twist, twist = (w, 0, 0, z) normalized, the swing's axis is horizontal.
+    const Eigen::Quaterniond q(Eigen::Matrix3d(gt.linear() * est.linear().transpose()));
+    result.T_gt_est.linear() =
+        Eigen::AngleAxisd(2.0 * std::atan2(q.z(), q.w()), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  } else {
+    result.T_gt_est.linear() = gt.linear() * est.linear().transpose();
+  }
+  result.T_gt_est.translation() = gt.translation() - result.T_gt_est.linear() * est.translation();
+  return result;
+}
+
 AssociatedTrajectory ApplyAlignment(const AssociatedTrajectory& trajectory,
                                     const AlignmentResult& alignment) {
   AssociatedTrajectory aligned = trajectory;

@@ -120,7 +120,7 @@ NeesResult EvaluateNees(const std::vector<GroundTruthState>& estimate,
                         const std::vector<GroundTruthState>& groundtruth,
                         const std::vector<PoseCovariance>& covariances, const EvaluationOptions& options) {
   const AssociatedTrajectory associated = Associate(estimate, groundtruth, options.association);
-  const AlignmentResult alignment = Align(associated, options.alignment);
+  const AlignmentResult alignment = AlignAtFirstPose(associated, options.alignment);
   return ComputeNees(ApplyAlignment(associated, alignment), alignment, covariances);
 }
 

@@ -74,6 +74,14 @@ struct AlignmentResult {
 /// (posyaw 2, se3/sim3 3, none 1) or, for sim3, the estimate does not move.
 AlignmentResult Align(const AssociatedTrajectory& trajectory, Alignment alignment);
 
+/// The alignment that puts the first estimate pose on its ground truth along the
+/// directions `alignment` frees (the gauge an estimator fixes with a prior on its
+/// first state): posyaw = its position and its rotation about z (the twist about z
+/// of R_gt R_est^T, so the remaining first-pose rotation error is a pure tilt);
+/// se3 and sim3 = its whole pose (scale 1); none = identity. std::invalid_argument
+/// when the trajectory is empty.
+AlignmentResult AlignAtFirstPose(const AssociatedTrajectory& trajectory, Alignment alignment);
+
 /// The trajectory with its estimate mapped through `alignment`:
 /// T_w_b_est <- T_gt_est * (scale * p, R).
 AssociatedTrajectory ApplyAlignment(const AssociatedTrajectory& trajectory,
