@@ -269,7 +269,7 @@ def plot_nees(nees_dir, rows, styles, out_path):
     label_log_axis(ax.yaxis, positive.min(), positive.max())
     ax.set_xlabel("time since the first frame every run estimated [s]")
     ax.set_ylabel("pose NEES, mean over the seeds (log scale)")
-    ax.set_title("Consistency: pose NEES (6 dof) over time, after position + yaw alignment")
+    ax.set_title("Consistency: pose NEES (6 dof) over time, aligned at the first pose (position + yaw)")
     finish(fig, ax, out_path)
     return True
 

@@ -211,8 +211,9 @@ void WriteResults(const SweepRequest& request, const std::vector<SweepResult>& r
   if (request.seeds > 0) {
     const ChiSquareBounds bounds = AneesBounds95(6, request.seeds);
     md << "\n## Monte Carlo: " << request.seeds << " noise seeds per configuration\n\n"
-       << "ANEES: mean NEES over runs and frames (pose error [p_gt - p, Log(R^T R_gt)] after position + yaw\n"
-          "alignment, covariance from the window's information). A consistent estimator has ANEES = dof; the\n"
+       << "ANEES: mean NEES over runs and frames (pose error [p_gt - p, Log(R^T R_gt)] with the estimate aligned\n"
+          "at its first pose in position + yaw, the gauge of the estimator's first-state prior; covariance from\n"
+          "the window's information). A consistent estimator has ANEES = dof; the\n"
           "run-mean NEES at one frame of N consistent runs lies within chi2(6N)/N's 95% bounds ([" << bounds.lower
        << ", " << bounds.upper << "] for N = " << request.seeds << ", Wilson-Hilferty) 95% of the time.\n\n"
        << MonteCarloMarkdown(SummarizeMonteCarlo(results));
