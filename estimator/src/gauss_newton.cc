@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
+#include <unordered_map>
+#include <utility>
 
-#include <ceres/crs_matrix.h>
+#include <ceres/cost_function.h>
 #include <ceres/manifold.h>
 #include <glog/logging.h>
 
@@ -11,168 +14,50 @@
 #include <Eigen/Core>
 
 #include "vio/marginalization/linear_algebra.h"
+#include "vio/marginalization/marginalization_prior.h"
 
 namespace vio {
 namespace {
 
-// A row of J with more nonzeros than this (a marginalization prior spanning
-// its blanket) is gathered into a dense matrix whose product Eigen blocks.
-constexpr int kDenseRow = 64;
+using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using ConstJacobian = Eigen::Map<const RowMajorMatrix>;
 
-/// One eliminated block: its rows of J and its part of the normal equations.
+/// Where a parameter block's tangent space sits among the columns.
+struct Columns {
+  int offset = 0;
+  int size = 0;
+};
+
+/// One parameter block of a residual block and where its Jacobian goes.
+struct Slot {
+  int dense = -1;       ///< dense block index, -1 for none
+  int eliminated = -1;  ///< eliminated block index, -1 for none
+  int coupling = -1;    ///< a dense block next to an eliminated one: its index in that block's `coupled`
+  int tangent = 0;      ///< tangent size
+  int jacobian = 0;     ///< offset of its (rows x tangent, row-major) Jacobian in the scratch buffer
+  bool variable() const { return dense >= 0 || eliminated >= 0; }
+};
+
+/// A residual block and the columns it touches, found once per solve.
+struct Residual {
+  ceres::ResidualBlockId id = nullptr;
+  int rows = 0;
+  /// A marginalization prior on dense blocks only: assembled from its information.
+  const marginalization::MarginalizationPrior* prior = nullptr;
+  std::vector<double*> values;  ///< its parameter blocks, in the residual's order
+  std::vector<Slot> slots;
+  int eliminated = -1;  ///< the eliminated block it touches, -1 for none
+};
+
+/// One eliminated block: its part of the normal equations.
 struct EliminatedBlock {
-  int offset = 0;               ///< first column
-  int size = 0;                 ///< tangent size
-  std::vector<int> rows;        ///< rows of J touching it
-  std::vector<int> dense_cols;  ///< dense columns those rows touch, ascending
-  Eigen::MatrixXd H;            ///< J_e^T J_e
-  Eigen::VectorXd b;            ///< J_e^T r
-  Eigen::MatrixXd W;            ///< J_d^T J_e on dense_cols
-  Eigen::MatrixXd H_inv;        ///< (pseudo-)inverse of H
+  Columns columns;
+  std::vector<int> coupled;        ///< dense blocks its residuals touch, ascending columns
+  Eigen::MatrixXd H;               ///< J_e^T J_e
+  Eigen::VectorXd b;               ///< J_e^T r
+  std::vector<Eigen::MatrixXd> W;  ///< J_d^T J_e per coupled dense block
+  Eigen::MatrixXd H_inv;           ///< (pseudo-)inverse of H
 };
-
-int TangentSize(const ceres::Problem& problem, const double* block) {
-  return problem.ParameterBlockTangentSize(block);
-}
-
-/// Normal equations of the dense columns and the per-block parts of the
-/// eliminated ones, summed in row order.
-class NormalEquationsBuilder {
- public:
-  NormalEquationsBuilder(const ceres::CRSMatrix& J, const std::vector<double>& r, int dense_dim,
-                         std::vector<EliminatedBlock>* blocks)
-      : J_(J), r_(r), dense_dim_(dense_dim), blocks_(*blocks),
-        H_(Eigen::MatrixXd::Zero(dense_dim, dense_dim)), b_(Eigen::VectorXd::Zero(dense_dim)) {}
-
-  void Build() {
-    for (int i = 0; i < J_.num_rows; ++i) {
-      const int e = EliminatedBlockOf(i);
-      if (e >= 0) blocks_[e].rows.push_back(i);
-      AddDenseRow(i);
-    }
-    AddGatheredDenseRows();
-    for (EliminatedBlock& block : blocks_) AddEliminatedBlock(block);
-  }
-
-  Eigen::MatrixXd& H() { return H_; }
-  Eigen::VectorXd& b() { return b_; }
-
- private:
-  // The eliminated block a row touches, -1 for none; two would couple them.
-  int EliminatedBlockOf(int i) const {
-    int found = -1;
-    for (int a = J_.rows[i]; a < J_.rows[i + 1]; ++a) {
-      if (J_.cols[a] < dense_dim_) continue;
-      const auto it = std::upper_bound(blocks_.begin(), blocks_.end(), J_.cols[a],
-                                       [](int col, const EliminatedBlock& b) { return col < b.offset; });
-      const int e = static_cast<int>(it - blocks_.begin()) - 1;
-      CHECK(found < 0 || found == e) << "a residual couples two eliminated blocks";
-      found = e;
-    }
-    return found;
-  }
-
-  void AddDenseRow(int i) {
-    const int begin = J_.rows[i], end = J_.rows[i + 1];
-    if (end - begin > kDenseRow) {
-      gathered_.push_back(i);
-      return;
-    }
-    for (int a = begin; a < end; ++a) {
-      if (J_.cols[a] >= dense_dim_) continue;
-      b_[J_.cols[a]] += J_.values[a] * r_[i];
-      for (int c = begin; c < end; ++c) {
-        if (J_.cols[c] < dense_dim_) H_(J_.cols[a], J_.cols[c]) += J_.values[a] * J_.values[c];
-      }
-    }
-  }
-
-  void AddGatheredDenseRows() {
-    if (gathered_.empty()) return;
-    Eigen::MatrixXd Jd = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(gathered_.size()), dense_dim_);
-    Eigen::VectorXd rd(Jd.rows());
-    for (Eigen::Index k = 0; k < Jd.rows(); ++k) {
-      const int i = gathered_[k];
-      for (int a = J_.rows[i]; a < J_.rows[i + 1]; ++a) {
-        CHECK_LT(J_.cols[a], dense_dim_) << "a dense row touches an eliminated block";
-        Jd(k, J_.cols[a]) = J_.values[a];
-      }
-      rd[k] = r_[i];
-    }
-    H_.noalias() += Jd.transpose() * Jd;
-    b_.noalias() += Jd.transpose() * rd;
-  }
-
-  void AddEliminatedBlock(EliminatedBlock& block) const {
-    for (int i : block.rows) {
-      for (int a = J_.rows[i]; a < J_.rows[i + 1]; ++a) {
-        if (J_.cols[a] < dense_dim_) block.dense_cols.push_back(J_.cols[a]);
-      }
-    }
-    std::sort(block.dense_cols.begin(), block.dense_cols.end());
-    block.dense_cols.erase(std::unique(block.dense_cols.begin(), block.dense_cols.end()), block.dense_cols.end());
-    const auto local = [&block](int col) {
-      return static_cast<int>(std::lower_bound(block.dense_cols.begin(), block.dense_cols.end(), col) -
-                              block.dense_cols.begin());
-    };
-    block.H = Eigen::MatrixXd::Zero(block.size, block.size);
-    block.b = Eigen::VectorXd::Zero(block.size);
-    block.W = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(block.dense_cols.size()), block.size);
-    for (int i : block.rows) {
-      for (int a = J_.rows[i]; a < J_.rows[i + 1]; ++a) {
-        if (J_.cols[a] < dense_dim_) continue;
-        const int ea = J_.cols[a] - block.offset;
-        block.b[ea] += J_.values[a] * r_[i];
-        for (int c = J_.rows[i]; c < J_.rows[i + 1]; ++c) {
-          if (J_.cols[c] >= dense_dim_) {
-            block.H(ea, J_.cols[c] - block.offset) += J_.values[a] * J_.values[c];
-          } else {
-            block.W(local(J_.cols[c]), ea) += J_.values[c] * J_.values[a];
-          }
-        }
-      }
-    }
-  }
-
-  const ceres::CRSMatrix& J_;
-  const std::vector<double>& r_;
-  const int dense_dim_;
-  std::vector<EliminatedBlock>& blocks_;
-  Eigen::MatrixXd H_;
-  Eigen::VectorXd b_;
-  std::vector<int> gathered_;
-};
-
-/// Schur complement of the eliminated blocks into (H, b), block by block.
-void EliminateBlocks(std::vector<EliminatedBlock>& blocks, Eigen::MatrixXd& H, Eigen::VectorXd& b) {
-  for (EliminatedBlock& block : blocks) {
-    block.H_inv = marginalization::PseudoInverse(block.H);
-    const Eigen::MatrixXd WH_inv = block.W * block.H_inv;
-    const Eigen::MatrixXd update = WH_inv * block.W.transpose();
-    const Eigen::VectorXd b_update = WH_inv * block.b;
-    const int m = static_cast<int>(block.dense_cols.size());
-    for (int p = 0; p < m; ++p) {
-      b[block.dense_cols[p]] -= b_update[p];
-      for (int q = 0; q < m; ++q) H(block.dense_cols[p], block.dense_cols[q]) -= update(p, q);
-    }
-  }
-}
-
-/// Solves H dx = -b (H symmetric positive definite; semi-definite falls back
-/// to LDLT). False when no finite solution exists.
-bool SolveDense(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, Eigen::VectorXd* dx) {
-  if (H.rows() == 0) {
-    dx->resize(0);
-    return true;
-  }
-  Eigen::LLT<Eigen::MatrixXd> llt(H);
-  if (llt.info() == Eigen::Success) {
-    *dx = llt.solve(-b);
-  } else {
-    *dx = H.ldlt().solve(-b);
-  }
-  return dx->allFinite();
-}
 
 void ApplyStep(ceres::Problem* problem, const std::vector<double*>& blocks, const Eigen::VectorXd& dx,
                int first_col) {
@@ -180,7 +65,6 @@ void ApplyStep(ceres::Problem* problem, const std::vector<double*>& blocks, cons
   std::vector<double> moved;
   for (double* block : blocks) {
     const int size = problem->ParameterBlockSize(block);
-    const int tangent = TangentSize(*problem, block);
     const ceres::Manifold* manifold = problem->GetManifold(block);
     if (manifold == nullptr) {
       for (int k = 0; k < size; ++k) block[k] += dx[col + k];
@@ -189,7 +73,7 @@ void ApplyStep(ceres::Problem* problem, const std::vector<double*>& blocks, cons
       CHECK(manifold->Plus(block, dx.data() + col, moved.data()));
       std::copy(moved.begin(), moved.end(), block);
     }
-    col += tangent;
+    col += problem->ParameterBlockTangentSize(block);
   }
 }
 
@@ -201,84 +85,306 @@ double SquaredNorm(const ceres::Problem& problem, const std::vector<double*>& bl
   return sum;
 }
 
-/// The linearized system at the current values with the eliminated blocks
-/// Schur-complemented out: H dx_dense = -b over the dense columns.
-struct Linearization {
-  double cost = 0;
-  int dense_dim = 0;
-  int num_cols = 0;
-  std::vector<double*> parameter_blocks;  ///< dense, then eliminated
-  std::vector<EliminatedBlock> blocks;
-  Eigen::MatrixXd H;
-  Eigen::VectorXd b;
-};
-
-bool Linearize(ceres::Problem* problem, const GaussNewtonLayout& layout, Linearization* out) {
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.residual_blocks = layout.residuals;
-  evaluate.parameter_blocks = layout.dense;
-  evaluate.parameter_blocks.insert(evaluate.parameter_blocks.end(), layout.eliminated.begin(),
-                                   layout.eliminated.end());
-  // An empty list would mean every block.
-  if (evaluate.parameter_blocks.empty() || evaluate.residual_blocks.empty()) return false;
-  std::vector<double> r;
-  ceres::CRSMatrix J;
-  if (!problem->Evaluate(evaluate, &out->cost, &r, nullptr, &J)) return false;
-
-  out->parameter_blocks = evaluate.parameter_blocks;
-  out->num_cols = J.num_cols;
-  out->dense_dim = 0;
-  for (const double* block : layout.dense) out->dense_dim += TangentSize(*problem, block);
-  out->blocks.assign(layout.eliminated.size(), EliminatedBlock());
-  int col = out->dense_dim;
-  for (size_t k = 0; k < out->blocks.size(); ++k) {
-    out->blocks[k].offset = col;
-    out->blocks[k].size = TangentSize(*problem, layout.eliminated[k]);
-    col += out->blocks[k].size;
+/// Solves H dx = -b for H symmetric positive definite, given by its upper
+/// triangle (semi-definite falls back to LDLT). False when no finite solution exists.
+bool SolveDense(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, Eigen::VectorXd* dx) {
+  if (H.rows() == 0) {
+    dx->resize(0);
+    return true;
   }
-  NormalEquationsBuilder builder(J, r, out->dense_dim, &out->blocks);
-  builder.Build();
-  EliminateBlocks(out->blocks, builder.H(), builder.b());
-  out->H = std::move(builder.H());
-  out->b = std::move(builder.b());
-  return true;
+  const Eigen::LLT<Eigen::MatrixXd, Eigen::Upper> llt(H);
+  if (llt.info() == Eigen::Success) {
+    *dx = llt.solve(-b);
+  } else {
+    *dx = Eigen::LDLT<Eigen::MatrixXd, Eigen::Upper>(H).solve(-b);
+  }
+  return dx->allFinite();
 }
 
 }  // namespace
 
-bool ReducedNormalEquations(ceres::Problem* problem, const GaussNewtonLayout& layout, ReducedSystem* system) {
-  Linearization linearization;
-  if (!Linearize(problem, layout, &linearization)) return false;
-  system->H = std::move(linearization.H);
-  system->b = std::move(linearization.b);
+// The normal equations of the dense columns (upper block triangle) and the
+// per-block parts of the eliminated ones, summed in the layout's residual order.
+struct GaussNewtonSolver::System {
+  ceres::Problem* problem;
+  GaussNewtonLayout layout;
+  std::vector<Columns> dense;
+  int dense_dim = 0;
+  std::vector<EliminatedBlock> eliminated;
+  std::vector<Residual> residuals;
+  // Buffers reused by every step.
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  std::vector<double> r;
+  std::vector<double> jacobians;
+  std::vector<double*> jacobian_pointers;
+  Eigen::VectorXd delta;
+  std::vector<Eigen::MatrixXd> T;
+
+  System(ceres::Problem* p, GaussNewtonLayout l) : problem(p), layout(std::move(l)) {
+    // A lookup from block to column only: no order depends on the addresses.
+    std::unordered_map<const double*, std::pair<int, int>> index;
+    for (size_t k = 0; k < layout.dense.size(); ++k) {
+      dense.push_back({dense_dim, problem->ParameterBlockTangentSize(layout.dense[k])});
+      dense_dim += dense.back().size;
+      index[layout.dense[k]] = {static_cast<int>(k), -1};
+    }
+    int col = dense_dim;
+    eliminated.resize(layout.eliminated.size());
+    for (size_t k = 0; k < layout.eliminated.size(); ++k) {
+      eliminated[k].columns = {col, problem->ParameterBlockTangentSize(layout.eliminated[k])};
+      col += eliminated[k].columns.size;
+      index[layout.eliminated[k]] = {-1, static_cast<int>(k)};
+    }
+    size_t scratch = 0;
+    for (ceres::ResidualBlockId id : layout.residuals) {
+      scratch = std::max(scratch, AddResidual(id, index));
+    }
+    for (EliminatedBlock& block : eliminated) {
+      std::sort(block.coupled.begin(), block.coupled.end());
+      block.coupled.erase(std::unique(block.coupled.begin(), block.coupled.end()), block.coupled.end());
+      block.W.resize(block.coupled.size());
+    }
+    for (Residual& residual : residuals) {
+      if (residual.eliminated < 0) continue;
+      const std::vector<int>& coupled = eliminated[residual.eliminated].coupled;
+      for (Slot& slot : residual.slots) {
+        if (slot.dense < 0) continue;
+        slot.coupling = static_cast<int>(std::lower_bound(coupled.begin(), coupled.end(), slot.dense) - coupled.begin());
+      }
+    }
+    jacobians.resize(scratch);
+  }
+
+  // The residual's slots; returns the scratch its Jacobians need.
+  size_t AddResidual(ceres::ResidualBlockId id,
+                     const std::unordered_map<const double*, std::pair<int, int>>& index) {
+    Residual& residual = residuals.emplace_back();
+    residual.id = id;
+    const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(id);
+    residual.rows = cost->num_residuals();
+    problem->GetParameterBlocksForResidualBlock(id, &residual.values);
+    int jacobian = 0;
+    for (const double* value : residual.values) {
+      Slot slot;
+      slot.tangent = problem->ParameterBlockTangentSize(value);
+      if (const auto it = index.find(value); it != index.end()) {
+        std::tie(slot.dense, slot.eliminated) = it->second;
+      }
+      if (slot.eliminated >= 0) {
+        CHECK(residual.eliminated < 0 || residual.eliminated == slot.eliminated)
+            << "a residual couples two eliminated blocks";
+        residual.eliminated = slot.eliminated;
+      }
+      slot.jacobian = jacobian;
+      if (slot.variable()) jacobian += residual.rows * slot.tangent;
+      residual.slots.push_back(slot);
+    }
+    if (residual.eliminated >= 0) {
+      for (const Slot& slot : residual.slots) {
+        if (slot.dense >= 0) eliminated[residual.eliminated].coupled.push_back(slot.dense);
+      }
+    } else {
+      residual.prior = dynamic_cast<const marginalization::MarginalizationPrior*>(cost);
+    }
+    r.resize(std::max(r.size(), static_cast<size_t>(residual.rows)));
+    jacobian_pointers.resize(std::max(jacobian_pointers.size(), residual.values.size()));
+    return static_cast<size_t>(jacobian);
+  }
+
+  void Zero() {
+    H.setZero(dense_dim, dense_dim);
+    b.setZero(dense_dim);
+    for (EliminatedBlock& block : eliminated) {
+      const int n = block.columns.size;
+      block.H.setZero(n, n);
+      block.b.setZero(n);
+      for (size_t k = 0; k < block.coupled.size(); ++k) block.W[k].setZero(dense[block.coupled[k]].size, n);
+    }
+  }
+
+  // J_i^T J_j into the upper block triangle of H.
+  void AddDensePair(const Slot& i, const Slot& j, const ConstJacobian& Ji, const ConstJacobian& Jj) {
+    const Columns& a = dense[i.dense];
+    const Columns& c = dense[j.dense];
+    if (a.offset <= c.offset) {
+      H.block(a.offset, c.offset, a.size, c.size).noalias() += Ji.transpose() * Jj;
+    } else {
+      H.block(c.offset, a.offset, c.size, a.size).noalias() += Jj.transpose() * Ji;
+    }
+  }
+
+  // A product for blocks (i, j) into the upper block triangle of H.
+  void AddDenseProduct(const Slot& i, const Slot& j, const Eigen::MatrixXd& product) {
+    const Columns& a = dense[i.dense];
+    const Columns& c = dense[j.dense];
+    if (a.offset <= c.offset) {
+      H.block(a.offset, c.offset, a.size, c.size) += product;
+    } else {
+      H.block(c.offset, a.offset, c.size, a.size) += product.transpose();
+    }
+  }
+
+  bool AddGeneric(const Residual& residual, double* cost) {
+    for (size_t k = 0; k < residual.slots.size(); ++k) {
+      const Slot& slot = residual.slots[k];
+      jacobian_pointers[k] = slot.variable() ? jacobians.data() + slot.jacobian : nullptr;
+    }
+    if (!problem->EvaluateResidualBlock(residual.id, /*apply_loss_function=*/true, cost, r.data(),
+                                        jacobian_pointers.data())) {
+      return false;
+    }
+    const Eigen::Map<const Eigen::VectorXd> res(r.data(), residual.rows);
+    const auto jacobian = [&](const Slot& slot) {
+      return ConstJacobian(jacobians.data() + slot.jacobian, residual.rows, slot.tangent);
+    };
+    for (size_t p = 0; p < residual.slots.size(); ++p) {
+      const Slot& i = residual.slots[p];
+      if (!i.variable()) continue;
+      const ConstJacobian Ji = jacobian(i);
+      if (i.dense >= 0) {
+        b.segment(dense[i.dense].offset, i.tangent).noalias() += Ji.transpose() * res;
+        for (size_t q = p; q < residual.slots.size(); ++q) {
+          const Slot& j = residual.slots[q];
+          if (j.dense >= 0) AddDensePair(i, j, Ji, jacobian(j));
+        }
+        continue;
+      }
+      EliminatedBlock& block = eliminated[i.eliminated];
+      block.b.noalias() += Ji.transpose() * res;
+      block.H.noalias() += Ji.transpose() * Ji;
+      for (const Slot& j : residual.slots) {
+        if (j.dense >= 0) block.W[j.coupling].noalias() += jacobian(j).transpose() * Ji;
+      }
+    }
+    return true;
+  }
+
+  // A prior r = r0 + Jp delta with tangent Jacobian Jp T: J^T J = T^T (Jp^T Jp) T
+  // and J^T r = T^T (Jp^T r0 + Jp^T Jp delta), from its precomputed information.
+  bool AddPrior(const Residual& residual, double* cost) {
+    const marginalization::MarginalizationPrior& prior = *residual.prior;
+    if (!prior.TangentJacobians(residual.values.data(), &delta, &T)) return false;
+    *cost = 0.5 * (prior.residual_at_x0() + prior.sqrt_information() * delta).squaredNorm();
+    const Eigen::VectorXd g = prior.information_vector() + prior.information() * delta;
+    const int n = static_cast<int>(residual.slots.size());
+    std::vector<bool> identity(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) identity[i] = T[i].isIdentity(0.0);
+    const auto tangent_map = [&](int i, const auto& m) -> Eigen::MatrixXd {
+      return identity[i] ? Eigen::MatrixXd(m) : Eigen::MatrixXd(T[i].transpose() * m);
+    };
+    for (int i = 0; i < n; ++i) {
+      const Slot& si = residual.slots[i];
+      if (si.dense < 0) continue;
+      b.segment(dense[si.dense].offset, si.tangent) += tangent_map(i, g.segment(prior.tangent_offset(i), si.tangent));
+      for (int j = i; j < n; ++j) {
+        const Slot& sj = residual.slots[j];
+        if (sj.dense < 0) continue;
+        const Eigen::MatrixXd left = tangent_map(
+            i, prior.information().block(prior.tangent_offset(i), prior.tangent_offset(j), si.tangent, sj.tangent));
+        AddDenseProduct(si, sj, identity[j] ? left : Eigen::MatrixXd(left * T[j]));
+      }
+    }
+    return true;
+  }
+
+  bool Assemble(double* cost) {
+    Zero();
+    *cost = 0;
+    for (const Residual& residual : residuals) {
+      double c = 0;
+      if (!(residual.prior != nullptr ? AddPrior(residual, &c) : AddGeneric(residual, &c))) return false;
+      *cost += c;
+    }
+    return true;
+  }
+
+  /// Schur complement of the eliminated blocks into (H, b), block by block.
+  void Eliminate() {
+    Eigen::MatrixXd WH_inv;
+    for (EliminatedBlock& block : eliminated) {
+      block.H_inv = marginalization::PseudoInverse(block.H);
+      for (size_t p = 0; p < block.coupled.size(); ++p) {
+        const Columns& a = dense[block.coupled[p]];
+        WH_inv.noalias() = block.W[p] * block.H_inv;
+        b.segment(a.offset, a.size).noalias() -= WH_inv * block.b;
+        for (size_t q = p; q < block.coupled.size(); ++q) {
+          const Columns& c = dense[block.coupled[q]];
+          H.block(a.offset, c.offset, a.size, c.size).noalias() -= WH_inv * block.W[q].transpose();
+        }
+      }
+    }
+  }
+
+  // The reduced system (H upper triangle, b) at the current values; false
+  // when the layout is empty or evaluation fails.
+  bool Reduce(double* cost) {
+    if (residuals.empty() || (layout.dense.empty() && layout.eliminated.empty())) return false;
+    if (!Assemble(cost)) return false;
+    Eliminate();
+    return true;
+  }
+
+  GaussNewtonStep Step() {
+    GaussNewtonStep step;
+    if (!Reduce(&step.cost)) return step;
+    Eigen::VectorXd dx_dense;
+    if (!SolveDense(H, b, &dx_dense)) return step;
+    Eigen::VectorXd dx(dense_dim + (eliminated.empty() ? 0 : eliminated.back().columns.offset +
+                                                                   eliminated.back().columns.size - dense_dim));
+    dx.head(dense_dim) = dx_dense;
+    for (const EliminatedBlock& block : eliminated) {
+      Eigen::VectorXd rhs = block.b;
+      for (size_t p = 0; p < block.coupled.size(); ++p) {
+        const Columns& a = dense[block.coupled[p]];
+        rhs.noalias() += block.W[p].transpose() * dx_dense.segment(a.offset, a.size);
+      }
+      dx.segment(block.columns.offset, block.columns.size).noalias() = -block.H_inv * rhs;
+    }
+    if (!dx.allFinite()) return step;
+    step.values_norm = std::sqrt(SquaredNorm(*problem, layout.dense) + SquaredNorm(*problem, layout.eliminated));
+    step.step_norm = dx.norm();
+    ApplyStep(problem, layout.dense, dx, 0);
+    ApplyStep(problem, layout.eliminated, dx, dense_dim);
+    step.ok = true;
+    return step;
+  }
+};
+
+GaussNewtonSolver::GaussNewtonSolver(ceres::Problem* problem, GaussNewtonLayout layout)
+    : system_(std::make_unique<System>(problem, std::move(layout))) {}
+
+GaussNewtonSolver::~GaussNewtonSolver() = default;
+
+GaussNewtonStep GaussNewtonSolver::Step() { return system_->Step(); }
+
+bool GaussNewtonSolver::Cost(double* cost) {
+  *cost = 0;
+  for (const Residual& residual : system_->residuals) {
+    double c = 0;
+    if (!system_->problem->EvaluateResidualBlock(residual.id, /*apply_loss_function=*/true, &c, nullptr, nullptr)) {
+      return false;
+    }
+    *cost += c;
+  }
   return true;
 }
 
+bool GaussNewtonSolver::Reduce(ReducedSystem* system) {
+  double cost = 0;
+  if (!system_->Reduce(&cost)) return false;
+  system->H = system_->H;
+  system->H.triangularView<Eigen::StrictlyLower>() = system->H.transpose();
+  system->b = system_->b;
+  return true;
+}
+
+bool ReducedNormalEquations(ceres::Problem* problem, const GaussNewtonLayout& layout, ReducedSystem* system) {
+  return GaussNewtonSolver(problem, layout).Reduce(system);
+}
+
 GaussNewtonStep TakeGaussNewtonStep(ceres::Problem* problem, const GaussNewtonLayout& layout) {
-  GaussNewtonStep step;
-  Linearization lin;
-  if (!Linearize(problem, layout, &lin)) return step;
-  step.cost = lin.cost;
-
-  Eigen::VectorXd dx = Eigen::VectorXd::Zero(lin.num_cols);
-  Eigen::VectorXd dx_dense;
-  if (!SolveDense(lin.H, lin.b, &dx_dense)) return step;
-  dx.head(lin.dense_dim) = dx_dense;
-  for (const EliminatedBlock& block : lin.blocks) {
-    Eigen::VectorXd rhs = block.b;
-    for (size_t p = 0; p < block.dense_cols.size(); ++p) {
-      rhs += block.W.row(static_cast<Eigen::Index>(p)).transpose() * dx_dense[block.dense_cols[p]];
-    }
-    dx.segment(block.offset, block.size) = -block.H_inv * rhs;
-  }
-  if (!dx.allFinite()) return step;
-
-  step.values_norm = std::sqrt(SquaredNorm(*problem, lin.parameter_blocks));
-  step.step_norm = dx.norm();
-  ApplyStep(problem, layout.dense, dx, 0);
-  ApplyStep(problem, layout.eliminated, dx, lin.dense_dim);
-  step.ok = true;
-  return step;
+  return GaussNewtonSolver(problem, layout).Step();
 }
 
 bool EvaluateCost(ceres::Problem* problem, const GaussNewtonLayout& layout, double* cost) {

@@ -142,9 +142,9 @@ SolveReport Window::TakeSteps(int steps, const SolverOptions& options) {
 
 SolveReport Window::GaussNewton(int max_steps, bool until_converged, const SolverOptions& options) {
   SolveReport report;
-  const GaussNewtonLayout layout = Layout();
+  GaussNewtonSolver solver(problem_.get(), Layout());
   for (int k = 0; k < max_steps; ++k) {
-    const GaussNewtonStep step = TakeGaussNewtonStep(problem_.get(), layout);
+    const GaussNewtonStep step = solver.Step();
     if (k == 0) report.initial_cost = report.final_cost = step.cost;
     if (!step.ok) {
       report.usable = false;
@@ -153,7 +153,7 @@ SolveReport Window::GaussNewton(int max_steps, bool until_converged, const Solve
     }
     ++report.iterations;
     double cost = 0;
-    if (!EvaluateCost(problem_.get(), layout, &cost)) {
+    if (!solver.Cost(&cost)) {
       report.usable = false;
       ++health_.failed_solves;
       break;

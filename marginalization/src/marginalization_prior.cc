@@ -81,6 +81,24 @@ MarginalizationPrior::MarginalizationPrior(std::vector<Block> blocks,
     tangent_sizes_.push_back(TangentSizeOf(block));
     offset += tangent_sizes_.back();
   }
+  information_ = Eigen::MatrixXd::Zero(offset, offset);
+  information_.selfadjointView<Eigen::Lower>().rankUpdate(sqrt_information_.transpose());
+  information_.triangularView<Eigen::StrictlyUpper>() = information_.transpose();
+  information_vector_ = sqrt_information_.transpose() * residual_at_x0_;
+}
+
+bool MarginalizationPrior::TangentJacobians(double const* const* parameters, Eigen::VectorXd* delta,
+                                            std::vector<Eigen::MatrixXd>* T) const {
+  delta->resize(sqrt_information_.cols());
+  T->resize(blocks_.size());
+  for (size_t i = 0; i < blocks_.size(); ++i) {
+    const int block = static_cast<int>(i);
+    if (!LocalCoordinates(block, parameters[i], delta->data() + tangent_offsets_[i]) ||
+        !MinusTangentJacobian(block, parameters[i], &(*T)[i])) {
+      return false;
+    }
+  }
+  return true;
 }
 
 bool MarginalizationPrior::Evaluate(double const* const* parameters, double* residuals,

@@ -10,6 +10,12 @@
 // Mutually uncoupled blocks (landmarks, which no residual ties to another
 // landmark) are eliminated first, one block at a time (Schur complement); the
 // reduced system over the rest is solved densely (Cholesky).
+//
+// The normal equations are assembled per residual block (J_i^T J_j into the
+// upper block triangle, no sparse Jacobian); a marginalization prior enters
+// through its precomputed information Jp^T Jp. GaussNewtonSolver keeps that
+// structure and its buffers across the steps of one solve.
+#include <memory>
 #include <vector>
 
 #include <ceres/problem.h>
@@ -47,6 +53,28 @@ struct ReducedSystem {
 /// Linearizes as TakeGaussNewtonStep does, without stepping; false when the
 /// layout is empty or evaluation fails.
 bool ReducedNormalEquations(ceres::Problem* problem, const GaussNewtonLayout& layout, ReducedSystem* system);
+
+/// Successive Gauss-Newton steps on one problem whose blocks and residuals do
+/// not change between the steps (the values do): the residual-to-column
+/// structure is found once, the buffers are reused.
+class GaussNewtonSolver {
+ public:
+  GaussNewtonSolver(ceres::Problem* problem, GaussNewtonLayout layout);
+  ~GaussNewtonSolver();
+  GaussNewtonSolver(const GaussNewtonSolver&) = delete;
+  GaussNewtonSolver& operator=(const GaussNewtonSolver&) = delete;
+
+  /// One undamped step on the layout's blocks (see TakeGaussNewtonStep).
+  GaussNewtonStep Step();
+  /// 1/2 |r|^2 at the current values (see EvaluateCost).
+  bool Cost(double* cost);
+  /// The reduced system at the current values (see ReducedNormalEquations).
+  bool Reduce(ReducedSystem* system);
+
+ private:
+  struct System;
+  std::unique_ptr<System> system_;
+};
 
 /// Takes one undamped Gauss-Newton step on the blocks of `layout`; every
 /// other block is held at its value.

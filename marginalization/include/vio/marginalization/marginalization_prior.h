@@ -68,6 +68,15 @@ class MarginalizationPrior final : public ceres::CostFunction {
   /// stays r0 + Jp (x ⊟ x0).
   void HoldJacobianAtLinearizationPoint() { jacobian_at_x0_ = true; }
   bool jacobian_at_linearization_point() const { return jacobian_at_x0_; }
+  /// Jp^T Jp, computed once: the prior's information on the stacked deltas.
+  const Eigen::MatrixXd& information() const { return information_; }
+  /// Jp^T r0, computed once.
+  const Eigen::VectorXd& information_vector() const { return information_vector_; }
+  /// The stacked deltas [x_i ⊟ x0_i] at `parameters`, and per block T_i (tangent x
+  /// tangent, see above): the tangent Jacobian of r is Jp_i T_i, so a solver can
+  /// assemble the normal equations from information() without forming Jp T.
+  bool TangentJacobians(double const* const* parameters, Eigen::VectorXd* delta,
+                        std::vector<Eigen::MatrixXd>* T) const;
   /// Column of block i in sqrt_information().
   int tangent_offset(int i) const { return tangent_offsets_[i]; }
   int tangent_size(int i) const { return tangent_sizes_[i]; }
@@ -86,6 +95,8 @@ class MarginalizationPrior final : public ceres::CostFunction {
   std::vector<Block> blocks_;
   Eigen::MatrixXd sqrt_information_;
   Eigen::VectorXd residual_at_x0_;
+  Eigen::MatrixXd information_;
+  Eigen::VectorXd information_vector_;
   std::vector<int> tangent_offsets_;
   std::vector<int> tangent_sizes_;
   bool jacobian_at_x0_ = false;
