@@ -7,6 +7,7 @@
 #include <utility>
 
 #include <ceres/cost_function.h>
+#include <ceres/loss_function.h>
 #include <ceres/manifold.h>
 #include <glog/logging.h>
 
@@ -41,6 +42,8 @@ struct Slot {
 /// A residual block and the columns it touches, found once per solve.
 struct Residual {
   ceres::ResidualBlockId id = nullptr;
+  const ceres::CostFunction* cost = nullptr;
+  const ceres::LossFunction* loss = nullptr;  ///< nullptr: none
   int rows = 0;
   /// A marginalization prior on dense blocks only: assembled from its information.
   const marginalization::MarginalizationPrior* prior = nullptr;
@@ -120,6 +123,8 @@ struct GaussNewtonSolver::System {
   std::vector<double*> jacobian_pointers;
   Eigen::VectorXd delta;
   std::vector<Eigen::MatrixXd> T;
+  Eigen::MatrixXd U;
+  Eigen::MatrixXd UUt;
 
   System(ceres::Problem* p, GaussNewtonLayout l) : problem(p), layout(std::move(l)) {
     // A lookup from block to column only: no order depends on the addresses.
@@ -162,6 +167,8 @@ struct GaussNewtonSolver::System {
     Residual& residual = residuals.emplace_back();
     residual.id = id;
     const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(id);
+    residual.cost = cost;
+    residual.loss = problem->GetLossFunctionForResidualBlock(id);
     residual.rows = cost->num_residuals();
     problem->GetParameterBlocksForResidualBlock(id, &residual.values);
     int jacobian = 0;
@@ -299,19 +306,70 @@ struct GaussNewtonSolver::System {
     return true;
   }
 
-  /// Schur complement of the eliminated blocks into (H, b), block by block.
+  /// Schur complement of the eliminated blocks into (H, b), block by block:
+  /// with H_inv = S S^T, U = [W_1; ...; W_m] S, the update is one rank-n
+  /// update H -= U U^T over the coupled columns (in place when they are
+  /// contiguous) and b -= U S^T b_e.
   void Eliminate() {
-    Eigen::MatrixXd WH_inv;
     for (EliminatedBlock& block : eliminated) {
       block.H_inv = marginalization::PseudoInverse(block.H);
+      const Eigen::LLT<Eigen::MatrixXd> factor(block.H_inv);
+      if (factor.info() != Eigen::Success) {  // H_inv singular (rank-truncated): no square root
+        EliminatePairwise(block);
+        continue;
+      }
+      int rows = 0;
+      bool contiguous = true;
       for (size_t p = 0; p < block.coupled.size(); ++p) {
         const Columns& a = dense[block.coupled[p]];
-        WH_inv.noalias() = block.W[p] * block.H_inv;
-        b.segment(a.offset, a.size).noalias() -= WH_inv * block.b;
-        for (size_t q = p; q < block.coupled.size(); ++q) {
-          const Columns& c = dense[block.coupled[q]];
-          H.block(a.offset, c.offset, a.size, c.size).noalias() -= WH_inv * block.W[q].transpose();
+        if (p > 0) {
+          const Columns& previous = dense[block.coupled[p - 1]];
+          contiguous = contiguous && a.offset == previous.offset + previous.size;
         }
+        rows += a.size;
+      }
+      U.resize(rows, block.columns.size);
+      rows = 0;
+      for (size_t p = 0; p < block.coupled.size(); ++p) {
+        U.middleRows(rows, block.W[p].rows()) = block.W[p];
+        rows += static_cast<int>(block.W[p].rows());
+      }
+      U = U * factor.matrixL();
+      const Eigen::VectorXd c = factor.matrixU() * block.b;
+      rows = 0;
+      for (size_t p = 0; p < block.coupled.size(); ++p) {
+        const Columns& a = dense[block.coupled[p]];
+        b.segment(a.offset, a.size).noalias() -= U.middleRows(rows, a.size) * c;
+        rows += a.size;
+      }
+      if (block.coupled.empty()) continue;
+      const int first = dense[block.coupled.front()].offset;
+      if (contiguous) {
+        H.block(first, first, rows, rows).selfadjointView<Eigen::Upper>().rankUpdate(U, -1.0);
+        continue;
+      }
+      UUt.setZero(rows, rows);
+      UUt.selfadjointView<Eigen::Upper>().rankUpdate(U);
+      for (size_t p = 0, rp = 0; p < block.coupled.size(); rp += dense[block.coupled[p]].size, ++p) {
+        const Columns& a = dense[block.coupled[p]];
+        for (size_t q = p, rq = rp; q < block.coupled.size(); rq += dense[block.coupled[q]].size, ++q) {
+          const Columns& c2 = dense[block.coupled[q]];
+          H.block(a.offset, c2.offset, a.size, c2.size) -= UUt.block(rp, rq, a.size, c2.size);
+        }
+      }
+    }
+  }
+
+  // The Schur update of one block through its pseudo-inverse, pair by pair.
+  void EliminatePairwise(const EliminatedBlock& block) {
+    Eigen::MatrixXd WH_inv;
+    for (size_t p = 0; p < block.coupled.size(); ++p) {
+      const Columns& a = dense[block.coupled[p]];
+      WH_inv.noalias() = block.W[p] * block.H_inv;
+      b.segment(a.offset, a.size).noalias() -= WH_inv * block.b;
+      for (size_t q = p; q < block.coupled.size(); ++q) {
+        const Columns& c = dense[block.coupled[q]];
+        H.block(a.offset, c.offset, a.size, c.size).noalias() -= WH_inv * block.W[q].transpose();
       }
     }
   }
@@ -358,14 +416,18 @@ GaussNewtonSolver::~GaussNewtonSolver() = default;
 
 GaussNewtonStep GaussNewtonSolver::Step() { return system_->Step(); }
 
+// As Ceres evaluates a residual block's cost (0.5 rho(|r|^2), invalid when
+// not finite) without its per-call bookkeeping.
 bool GaussNewtonSolver::Cost(double* cost) {
+  System& system = *system_;
   *cost = 0;
-  for (const Residual& residual : system_->residuals) {
-    double c = 0;
-    if (!system_->problem->EvaluateResidualBlock(residual.id, /*apply_loss_function=*/true, &c, nullptr, nullptr)) {
-      return false;
-    }
-    *cost += c;
+  for (const Residual& residual : system.residuals) {
+    if (!residual.cost->Evaluate(residual.values.data(), system.r.data(), nullptr)) return false;
+    const double squared_norm = Eigen::Map<const Eigen::VectorXd>(system.r.data(), residual.rows).squaredNorm();
+    if (!std::isfinite(squared_norm)) return false;
+    double rho[3] = {squared_norm, 1, 0};
+    if (residual.loss != nullptr) residual.loss->Evaluate(squared_norm, rho);
+    *cost += 0.5 * rho[0];
   }
   return true;
 }

@@ -30,15 +30,20 @@ std::vector<ceres::ResidualBlockId> Window::ResidualOrder() const {
   return order;
 }
 
+// Dense columns: every pose, then every speed/bias block (both by state id),
+// then the landmarks tied by a prior. With the poses side by side, the poses
+// seeing a landmark are one contiguous range of columns (a track is seen from
+// consecutive states), so its Schur update is one rank-3 update in place.
 GaussNewtonLayout Window::Layout() const {
   const std::set<const double*> in_prior = BlocksInPriors();
   GaussNewtonLayout layout;
   layout.residuals = ResidualOrder();
   const auto variable = [this](const double* block) { return !problem_->IsParameterBlockConstant(block); };
   for (const auto& [id, s] : states_) {
-    for (const double* block : {s.pose, s.speed_bias}) {
-      if (variable(block)) layout.dense.push_back(const_cast<double*>(block));
-    }
+    if (variable(s.pose)) layout.dense.push_back(const_cast<double*>(s.pose));
+  }
+  for (const auto& [id, s] : states_) {
+    if (variable(s.speed_bias)) layout.dense.push_back(const_cast<double*>(s.speed_bias));
   }
   for (const auto& [id, landmark] : landmarks_) {
     if (!variable(landmark.p_w)) continue;
