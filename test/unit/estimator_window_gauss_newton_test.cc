@@ -45,21 +45,29 @@ std::map<const double*, std::vector<double>> Values(ceres::Problem& problem) {
   return values;
 }
 
+/// J (dense, from Ceres' CRS Jacobian) and r of `evaluate`'s blocks.
+void EvaluateDense(ceres::Problem& problem, const ceres::Problem::EvaluateOptions& evaluate, Eigen::MatrixXd* J,
+                   Eigen::VectorXd* residual) {
+  double cost = 0;
+  std::vector<double> r;
+  ceres::CRSMatrix crs;
+  ASSERT_TRUE(problem.Evaluate(evaluate, &cost, &r, nullptr, &crs));
+  *J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int i = 0; i < crs.num_rows; ++i) {
+    for (int a = crs.rows[i]; a < crs.rows[i + 1]; ++a) (*J)(i, crs.cols[a]) = crs.values[a];
+  }
+  *residual = Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
+}
+
 /// x ⊞ dx of the closed-form Gauss-Newton step of the whole problem.
 std::map<const double*, std::vector<double>> ClosedFormStep(ceres::Problem& problem) {
   std::vector<double*> blocks;
   problem.GetParameterBlocks(&blocks);
   ceres::Problem::EvaluateOptions evaluate;
   evaluate.parameter_blocks = blocks;
-  double cost = 0;
-  std::vector<double> r;
-  ceres::CRSMatrix crs;
-  EXPECT_TRUE(problem.Evaluate(evaluate, &cost, &r, nullptr, &crs));
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
-  for (int i = 0; i < crs.num_rows; ++i) {
-    for (int a = crs.rows[i]; a < crs.rows[i + 1]; ++a) J(i, crs.cols[a]) = crs.values[a];
-  }
-  const Eigen::VectorXd residual = Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
+  Eigen::MatrixXd J;
+  Eigen::VectorXd residual;
+  EvaluateDense(problem, evaluate, &J, &residual);
   const Eigen::VectorXd dx = J.colPivHouseholderQr().solve(-residual);
   std::map<const double*, std::vector<double>> after;
   int col = 0;
@@ -127,16 +135,11 @@ void SparseJacobianNormalEquations(ceres::Problem& problem, const GaussNewtonLay
   evaluate.residual_blocks = layout.residuals;
   evaluate.parameter_blocks = layout.dense;
   evaluate.parameter_blocks.insert(evaluate.parameter_blocks.end(), layout.eliminated.begin(), layout.eliminated.end());
-  double cost = 0;
-  std::vector<double> r;
-  ceres::CRSMatrix crs;
-  ASSERT_TRUE(problem.Evaluate(evaluate, &cost, &r, nullptr, &crs));
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
-  for (int i = 0; i < crs.num_rows; ++i) {
-    for (int a = crs.rows[i]; a < crs.rows[i + 1]; ++a) J(i, crs.cols[a]) = crs.values[a];
-  }
+  Eigen::MatrixXd J;
+  Eigen::VectorXd r;
+  EvaluateDense(problem, evaluate, &J, &r);
   *H = J.transpose() * J;
-  *b = J.transpose() * Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
+  *b = J.transpose() * r;
 }
 
 double RelativeDifference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) { return (a - b).norm() / b.norm(); }
