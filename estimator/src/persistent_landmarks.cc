@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <tuple>
 
+#include <glog/logging.h>
+
 #include "vio/estimator/window.h"
 
 namespace vio {
@@ -65,6 +67,14 @@ PersistentDecision PersistentLandmarks::Decide(Timestamp now_ns, const std::vect
   std::sort(decision.promoted.begin(), decision.promoted.end());
   std::sort(decision.retired.begin(), decision.retired.end());
   return decision;
+}
+
+void LogPersistentCounts(const PersistentLandmarks& persistent) {
+  if (!persistent.enabled()) return;
+  const PersistentCounts& c = persistent.counts();
+  LOG(INFO) << "long-lived landmarks: " << c.promoted << " promoted, " << c.returns << " re-observations after a gap, "
+            << c.retired_unseen << " retired unseen, " << c.retired_budget << " retired over the budget, "
+            << persistent.size() << " kept at the end";
 }
 
 std::vector<LandmarkId> KeepLongLived(const std::vector<LandmarkId>& marginalizing, Timestamp now_ns,

@@ -44,6 +44,11 @@ class MsckfPolicy final : public Policy {
   /// convergence (fixed_lag).
   MsckfPolicy(const EstimatorOptions& options, std::optional<int> gn_steps);
   PolicyTiming Update(const StereoFrame& frame, StateId new_state, Window& window) override;
+  /// Logs the long-lived landmarks' counts; the trajectory is the filter's.
+  bool Finish(Window& /*window*/) override {
+    LogPersistentCounts(persistent_);
+    return false;
+  }
   const MsckfCounts& counts() const { return counts_; }
   const PersistentLandmarks& persistent() const { return persistent_; }
 

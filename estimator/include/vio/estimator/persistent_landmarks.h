@@ -79,6 +79,9 @@ class PersistentLandmarks {
   PersistentCounts counts_;
 };
 
+/// Logs the counts (at the end of a run) when long-lived landmarks are on.
+void LogPersistentCounts(const PersistentLandmarks& persistent);
+
 /// The landmarks to marginalize with a leaving state, when `marginalizing`
 /// is what the policy would marginalize without long-lived landmarks: kept
 /// ones and newly promoted ones (observed at least persistent_min_track times

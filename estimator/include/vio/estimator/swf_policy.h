@@ -16,6 +16,11 @@ class SwfPolicy final : public Policy {
  public:
   explicit SwfPolicy(const EstimatorOptions& options) : options_(options), persistent_(options.persistent) {}
   PolicyTiming Update(const StereoFrame& frame, StateId new_state, Window& window) override;
+  /// Logs the long-lived landmarks' counts; the trajectory is the filter's.
+  bool Finish(Window& /*window*/) override {
+    LogPersistentCounts(persistent_);
+    return false;
+  }
   const PersistentLandmarks& persistent() const { return persistent_; }
 
  private:
