@@ -25,7 +25,7 @@ bool IsLeaving(StateId state, const std::vector<StateId>& leaving) {
 }  // namespace
 
 MsckfPolicy::MsckfPolicy(const EstimatorOptions& options, std::optional<int> gn_steps)
-    : options_(options), gn_steps_(gn_steps) {
+    : options_(options), gn_steps_(gn_steps), persistent_(options.persistent) {
   CHECK(!gn_steps_ || *gn_steps_ >= 1);
   CHECK_GE(options_.policy.window_size, 2) << "the MSCKF needs a window of at least 2 states";
 }
@@ -33,9 +33,19 @@ MsckfPolicy::MsckfPolicy(const EstimatorOptions& options, std::optional<int> gn_
 PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Window& window) {
   PolicyTiming timing;
   auto start = std::chrono::steady_clock::now();
-  for (const StereoObservation& obs : frame.observations) tracks_[obs.landmark].emplace_back(new_state, obs.z_px);
+  for (const StereoObservation& obs : frame.observations) {
+    if (window.HasLandmark(obs.landmark)) {  // a kept landmark: the observation re-attaches to it
+      window.AddObservation(new_state, obs.landmark, obs.z_px);
+    } else {
+      tracks_[obs.landmark].emplace_back(new_state, obs.z_px);
+    }
+  }
+  persistent_.Observe(frame);
   const std::vector<StateId> leaving = LeavingStates(window);
-  const std::vector<LandmarkId> added = AddTriangulated(MatureTracks(frame, leaving), window);
+  std::vector<LandmarkId> retired;
+  std::vector<TrackUpdate> updates = PromoteTracks(frame, leaving, window, retired);
+  for (TrackUpdate& update : MatureTracks(frame, leaving)) updates.push_back(std::move(update));
+  const std::vector<LandmarkId> added = AddTriangulated(updates, window);
   window.RefreshImuFactors(options_.model.reintegrate_bias_threshold);
   timing.build_ms = MillisecondsSince(start);
 
@@ -48,7 +58,12 @@ PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
           << " states leaving, cost " << report.initial_cost << " -> " << report.final_cost;
 
   start = std::chrono::steady_clock::now();
-  window.Marginalize(leaving, added);
+  std::vector<LandmarkId> marginalized;
+  for (LandmarkId id : added) {
+    if (!persistent_.IsKept(id)) marginalized.push_back(id);
+  }
+  marginalized.insert(marginalized.end(), retired.begin(), retired.end());
+  window.Marginalize(leaving, marginalized);
   ForgetObservationsOf(leaving);
   timing.marginalize_ms = MillisecondsSince(start);
   return timing;
@@ -83,6 +98,38 @@ std::vector<StateId> MsckfPolicy::LeavingStates(const Window& window) const {
     ++i;
   }
   return leaving;
+}
+
+// Long-lived landmarks: tracks about to be used (ended, or seen from a
+// leaving state) compete for the budget; a promoted track is used whole, and
+// its landmark stays (not marginalized with the update). `retired`: kept
+// landmarks to marginalize now.
+std::vector<MsckfPolicy::TrackUpdate> MsckfPolicy::PromoteTracks(const StereoFrame& frame,
+                                                                 const std::vector<StateId>& leaving,
+                                                                 const Window& window,
+                                                                 std::vector<LandmarkId>& retired) {
+  std::vector<TrackUpdate> updates;
+  if (!persistent_.enabled()) return updates;
+  std::set<LandmarkId> seen_now;
+  for (const StereoObservation& obs : frame.observations) seen_now.insert(obs.landmark);
+  std::vector<PromotionCandidate> candidates;
+  for (const auto& [id, observations] : tracks_) {
+    const bool ended = seen_now.count(id) == 0;
+    const bool loses_state = std::any_of(observations.begin(), observations.end(),
+                                         [&](const Observation& o) { return IsLeaving(o.first, leaving); });
+    if (static_cast<int>(observations.size()) < options_.msckf.msckf_min_track_length || !(ended || loses_state)) {
+      continue;
+    }
+    candidates.push_back({id, static_cast<int>(observations.size()), window.state(observations.back().first).t_ns});
+  }
+  PersistentDecision decision = persistent_.Decide(frame.t_ns, candidates);
+  for (LandmarkId id : decision.promoted) {
+    auto it = tracks_.find(id);
+    updates.push_back({id, std::move(it->second)});
+    tracks_.erase(it);
+  }
+  retired = std::move(decision.retired);
+  return updates;
 }
 
 // Tracks not seen in the newest frame give all their observations. Tracks
@@ -153,6 +200,7 @@ std::vector<LandmarkId> MsckfPolicy::AddTriangulated(const std::vector<TrackUpda
     const TriangulationResult result = TriangulateMultiView(views, window.stereo(), triangulation);
     if (!result.p_w) {
       ++counts_.rejected;
+      persistent_.Release(update.id);
       continue;
     }
     window.AddLandmark(update.id, *result.p_w);

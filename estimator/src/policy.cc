@@ -54,10 +54,14 @@ PolicyTiming AddFrameAndSolve(const StereoFrame& frame, StateId state, const Est
   return timing;
 }
 
+std::vector<LandmarkId> LandmarksLeavingWith(const std::vector<StateId>& leaving, const PolicyOptions& options,
+                                             const Window& window) {
+  return options.swf_landmarks == "keep" ? LandmarksOnlySeenFrom(window, leaving) : LandmarksSeenFrom(window, leaving);
+}
+
 void MarginalizeStateAndItsLandmarks(StateId state, const PolicyOptions& options, Window& window) {
   const std::vector<StateId> leaving = {state};
-  window.Marginalize(leaving, options.swf_landmarks == "keep" ? LandmarksOnlySeenFrom(window, leaving)
-                                                               : LandmarksSeenFrom(window, leaving));
+  window.Marginalize(leaving, LandmarksLeavingWith(leaving, options, window));
 }
 
 std::vector<LandmarkId> LandmarksOnlySeenFrom(const Window& window, const std::vector<StateId>& leaving) {

@@ -5,9 +5,14 @@ namespace vio {
 PolicyTiming SwfPolicy::Update(const StereoFrame& frame, StateId new_state, Window& window) {
   PolicyTiming timing = AddFrameAndSolve(frame, new_state, options_, window);
   const auto start = std::chrono::steady_clock::now();
+  persistent_.Observe(frame);
+  std::vector<StateId> leaving;
   if (static_cast<int>(window.states().size()) > options_.policy.window_size) {
-    MarginalizeStateAndItsLandmarks(window.states().begin()->first, options_.policy, window);
+    leaving.push_back(window.states().begin()->first);
   }
+  const std::vector<LandmarkId> landmarks =
+      KeepLongLived(LandmarksLeavingWith(leaving, options_.policy, window), frame.t_ns, window, persistent_);
+  window.Marginalize(leaving, landmarks);
   timing.marginalize_ms = MillisecondsSince(start);
   return timing;
 }

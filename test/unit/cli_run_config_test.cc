@@ -35,5 +35,29 @@ TEST(RunConfig, UnknownKeyInARunFileIsAnError) {
   }
 }
 
+// Long-lived landmarks are an option of the windowed policies: asking for them
+// with another policy, or for a negative budget, names the option.
+TEST(RunConfig, PersistentLandmarksAreCheckedAgainstThePolicy) {
+  const std::string dir = test::MakeTempDir("run_config");
+  const std::string path = dir + "/persistent.yaml";
+  std::ofstream(path) << "policy:\n  policy: ekf\npersistent:\n  persistent_landmarks: 20\n";
+  try {
+    LoadRunConfig(path);
+    FAIL() << "persistent_landmarks accepted with ekf";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("--persistent_landmarks=20"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("ekf"), std::string::npos) << e.what();
+  }
+  std::ofstream(path) << "policy:\n  policy: msckf\npersistent:\n  persistent_landmarks: 20\n";
+  EXPECT_EQ(LoadRunConfig(path).estimator.persistent.persistent_landmarks, 20);
+  std::ofstream(path) << "persistent:\n  persistent_landmarks: -1\n";
+  try {
+    LoadRunConfig(path);
+    FAIL() << "a negative budget accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("persistent_landmarks"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace vio::tools

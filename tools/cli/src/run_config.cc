@@ -8,6 +8,7 @@ void BindRunConfig(RunConfig* config, OptionRegistry* registry) {
   registry->Add("frontend", &config->frontend);
   registry->Add("policy", &config->estimator.policy);
   registry->Add("msckf", &config->estimator.msckf);
+  registry->Add("persistent", &config->estimator.persistent);
   registry->Add("batch", &config->estimator.batch);
   registry->Add("solver", &config->estimator.solver);
   registry->Add("model", &config->estimator.model);
@@ -27,6 +28,11 @@ void ValidateRunConfig(const RunConfig& config) {
   if (msckf_like && policy.window_size < 2) {
     throw ConfigError("--window_size=" + std::to_string(policy.window_size) + ": the " + policy.policy +
                       " policy needs a window of at least 2 states");
+  }
+  const bool windowed = msckf_like || policy.policy == "swf";
+  if (config.estimator.persistent.persistent_landmarks > 0 && !windowed) {
+    throw ConfigError("--persistent_landmarks=" + std::to_string(config.estimator.persistent.persistent_landmarks) +
+                      ": long-lived landmarks are for the policies swf, msckf and fixed_lag, not " + policy.policy);
   }
 }
 

@@ -79,6 +79,26 @@ struct MsckfOptions {
   }
 };
 
+/// Long-lived landmarks of the windowed policies swf, msckf and fixed_lag
+/// (persistent_landmarks.h): kept as parameters beyond the window.
+struct PersistentOptions {
+  int persistent_landmarks = 0;      ///< most landmarks kept beyond the window [count]; 0 = off
+  int persistent_min_track = 5;      ///< observations a landmark needs before it is kept [count]
+  double persistent_retire_s = 10.0; ///< a kept landmark not re-observed for this long is marginalized [s]
+
+  template <class V>
+  void Visit(V& v) {
+    v("persistent_landmarks", persistent_landmarks,
+      "swf, msckf, fixed_lag: most landmarks kept as parameters after their observing states leave (their "
+      "information in the marginalization prior; re-observed ids re-attach); 0 = off [count]",
+      Between(0, 1000));
+    v("persistent_min_track", persistent_min_track,
+      "observations a landmark needs before it is kept beyond the window [count]", AtLeast(2));
+    v("persistent_retire_s", persistent_retire_s,
+      "a kept landmark not re-observed for this long is marginalized into the prior [s]", Positive());
+  }
+};
+
 /// Full batch: no marginalization; old states frozen while running, all
 /// solved together at the end.
 struct BatchOptions {
@@ -203,6 +223,7 @@ struct InitOptions {
 struct EstimatorOptions {
   PolicyOptions policy;
   MsckfOptions msckf;
+  PersistentOptions persistent;
   BatchOptions batch;
   SolverOptions solver;
   ModelOptions model;

@@ -16,10 +16,17 @@
 // goes on without them (`leaving_views`), or, with `whole_track`, any track
 // seen from a leaving state is used whole and restarts. Older poses thin
 // out, so the window reaches arbitrarily far into the past.
+//
+// With persistent_landmarks > 0 (persistent_landmarks.h), a track about to
+// be used that was observed at least persistent_min_track times may be kept:
+// its landmark is triangulated from the whole track, added, and stays a
+// parameter (OpenVINS' "SLAM features"); its later observations are added to
+// the window directly, its views from leaving states go into the prior.
 #include <map>
 #include <optional>
 #include <vector>
 
+#include "vio/estimator/persistent_landmarks.h"
 #include "vio/estimator/policy.h"
 
 namespace vio {
@@ -37,7 +44,13 @@ class MsckfPolicy final : public Policy {
   /// convergence (fixed_lag).
   MsckfPolicy(const EstimatorOptions& options, std::optional<int> gn_steps);
   PolicyTiming Update(const StereoFrame& frame, StateId new_state, Window& window) override;
+  /// Logs the long-lived landmarks' counts; the trajectory is the filter's.
+  bool Finish(Window& /*window*/) override {
+    LogPersistentCounts(persistent_);
+    return false;
+  }
   const MsckfCounts& counts() const { return counts_; }
+  const PersistentLandmarks& persistent() const { return persistent_; }
 
  private:
   using Observation = std::pair<StateId, Eigen::Vector3d>;
@@ -48,6 +61,8 @@ class MsckfPolicy final : public Policy {
   };
 
   std::vector<StateId> LeavingStates(const Window& window) const;
+  std::vector<TrackUpdate> PromoteTracks(const StereoFrame& frame, const std::vector<StateId>& leaving,
+                                         const Window& window, std::vector<LandmarkId>& retired);
   std::vector<TrackUpdate> MatureTracks(const StereoFrame& frame, const std::vector<StateId>& leaving);
   std::optional<TrackUpdate> LeavingViews(std::vector<Observation>& track, LandmarkId id,
                                           const std::vector<StateId>& leaving) const;
@@ -59,6 +74,7 @@ class MsckfPolicy final : public Policy {
   std::optional<int> gn_steps_;
   std::map<LandmarkId, std::vector<Observation>> tracks_;  ///< unused observations, oldest first
   MsckfCounts counts_;
+  PersistentLandmarks persistent_;  ///< long-lived landmarks (off unless persistent_landmarks > 0)
   int frames_without_observations_ = 0;  ///< the current run of empty frames (tracking loss)
   int reanchor_frames_ = 0;              ///< frames left solving to convergence after a long loss
 };

@@ -54,8 +54,12 @@ int AddStereoObservations(const StereoFrame& frame, StateId state, const ModelOp
 PolicyTiming AddFrameAndSolve(const StereoFrame& frame, StateId state, const EstimatorOptions& options,
                               Window& window);
 
-/// Marginalizes one state with the landmarks `swf_landmarks` names: those
-/// only it sees (keep) or every one it sees (marginalize).
+/// The landmarks that leave with the states `leaving` under `swf_landmarks`:
+/// those only they see (keep) or every one they see (marginalize).
+std::vector<LandmarkId> LandmarksLeavingWith(const std::vector<StateId>& leaving, const PolicyOptions& options,
+                                             const Window& window);
+
+/// Marginalizes one state with the landmarks that leave with it (LandmarksLeavingWith).
 void MarginalizeStateAndItsLandmarks(StateId state, const PolicyOptions& options, Window& window);
 
 /// Landmarks observed from no state other than those in `leaving`.
