@@ -4,15 +4,16 @@
 
 #include "vio/estimator/pose_manifold.h"
 #include "vio/estimator/so3.h"
+#include "imu_state_index.h"
 
 namespace vio {
 namespace {
 
-constexpr int kR = ImuPreintegration::kRotation;
-constexpr int kV = ImuPreintegration::kVelocity;
-constexpr int kP = ImuPreintegration::kPosition;
-constexpr int kBg = ImuPreintegration::kBiasGyro;
-constexpr int kBa = ImuPreintegration::kBiasAccel;
+using imu_state_index::kBa;
+using imu_state_index::kBg;
+using imu_state_index::kP;
+using imu_state_index::kR;
+using imu_state_index::kV;
 
 // Columns inside the speed-bias block [v, b_g, b_a] and the pose tangent
 // [dp, dtheta].

@@ -11,17 +11,18 @@
 #include <glog/logging.h>
 
 #include "vio/estimator/so3.h"
+#include "imu_state_index.h"
 
 namespace vio {
 namespace {
 
 using Matrix15d = ImuPreintegration::Matrix15d;
 using Matrix15x12d = Eigen::Matrix<double, 15, 12>;
-constexpr int kR = ImuPreintegration::kRotation;
-constexpr int kV = ImuPreintegration::kVelocity;
-constexpr int kP = ImuPreintegration::kPosition;
-constexpr int kBg = ImuPreintegration::kBiasGyro;
-constexpr int kBa = ImuPreintegration::kBiasAccel;
+using imu_state_index::kBa;
+using imu_state_index::kBg;
+using imu_state_index::kP;
+using imu_state_index::kR;
+using imu_state_index::kV;
 
 // Noise columns of G: [n_g, n_a, n_bg, n_ba].
 constexpr int kNoiseGyro = 0;

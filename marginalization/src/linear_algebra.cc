@@ -41,7 +41,7 @@ void RequireSizes(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, int keep_d
   }
 }
 
-Eigen::MatrixXd Symmetrized(const Eigen::MatrixXd& H) {
+Eigen::MatrixXd SymmetricPart(const Eigen::MatrixXd& H) {
   return 0.5 * (H + H.transpose());
 }
 
@@ -51,7 +51,7 @@ SignificantEigenpairs DecomposeSignificant(const Eigen::MatrixXd& H,
   if (H.rows() == 0) {
     return result;
   }
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(Symmetrized(H));
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(SymmetricPart(H));
   CHECK(solver.info() == Eigen::Success)
       << "eigen-decomposition of a finite symmetric matrix failed";
   const Eigen::VectorXd& lambda = solver.eigenvalues();  // ascending
@@ -118,7 +118,7 @@ SqrtInformation SqrtByPivotedLdlt(const Eigen::MatrixXd& H, const Eigen::VectorX
   if (n == 0) {
     return {Eigen::MatrixXd(0, 0), Eigen::VectorXd(0)};
   }
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(Symmetrized(H));
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(SymmetricPart(H));
   if (ldlt.info() != Eigen::Success) {  // a zero pivot with a non-zero column: not PSD
     return SqrtByEigen(H, b, threshold);
   }
@@ -165,7 +165,7 @@ NormalEquations SchurComplement(const Eigen::MatrixXd& H, const Eigen::VectorXd&
       PseudoInverse(H.bottomRightCorner(marg_dim, marg_dim), threshold);
   const Eigen::MatrixXd H_KM_H_MM_inv = H.topRightCorner(keep_dim, marg_dim) * H_MM_inv;
   NormalEquations marginal;
-  marginal.H = Symmetrized(H.topLeftCorner(keep_dim, keep_dim) -
+  marginal.H = SymmetricPart(H.topLeftCorner(keep_dim, keep_dim) -
                            H_KM_H_MM_inv * H.bottomLeftCorner(marg_dim, keep_dim));
   marginal.b = b.head(keep_dim) - H_KM_H_MM_inv * b.tail(marg_dim);
   return marginal;
@@ -191,7 +191,7 @@ NormalEquations SchurComplementOfUncoupledBlocks(const Eigen::MatrixXd& H, const
     EliminateBlock(H, b, offset, dim, threshold, &marginal);
     offset += dim;
   }
-  marginal.H = Symmetrized(marginal.H);
+  marginal.H = SymmetricPart(marginal.H);
   return marginal;
 }
 

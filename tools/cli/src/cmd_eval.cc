@@ -63,7 +63,7 @@ std::vector<double> ParseLengths(const std::string& text) {
   return lengths_m;
 }
 
-EvalRequest RequestFromFlags(const std::vector<std::string>& args) {
+EvalRequest EvalRequestFromFlags(const std::vector<std::string>& args) {
   if (!args.empty()) throw std::invalid_argument("unexpected argument '" + args.front() + "'");
   if (FLAGS_estimate.empty()) throw std::invalid_argument("--estimate=FILE is required");
   if (FLAGS_groundtruth.empty()) throw std::invalid_argument("--groundtruth=FILE_OR_DIR is required");
@@ -130,7 +130,7 @@ void RunEval(const EvalRequest& request) {
 int EvalMain(const std::vector<std::string>& args) {
   EvalRequest request;
   try {
-    request = RequestFromFlags(args);
+    request = EvalRequestFromFlags(args);
   } catch (const std::exception& e) {
     std::cerr << "vio eval: " << e.what() << "\n(see vio eval --help)\n";
     return 2;

@@ -104,7 +104,7 @@ std::vector<std::string> ForwardedOptionFlags() {
   return forwarded;
 }
 
-SweepRequest RequestFromFlags(const std::vector<std::string>& args) {
+SweepRequest SweepRequestFromFlags(const std::vector<std::string>& args) {
   if (!args.empty()) throw std::invalid_argument("unexpected argument '" + args.front() + "'");
   if (FLAGS_output_dir.empty()) throw std::invalid_argument("--output_dir is required");
   SweepRequest request;
@@ -177,7 +177,7 @@ int Sweep(const SweepRequest& request) {
 int SweepMain(const std::vector<std::string>& args) {
   SweepRequest request;
   try {
-    request = RequestFromFlags(args);
+    request = SweepRequestFromFlags(args);
   } catch (const std::invalid_argument& e) {
     std::cerr << "vio sweep: " << e.what() << "\n(see vio sweep --help)\n";
     return 2;

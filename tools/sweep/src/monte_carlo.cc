@@ -41,7 +41,7 @@ std::map<Timestamp, double> ReadPoseNees(const std::string& path) {
   return nees;
 }
 
-std::string Fixed(double value, int digits) {
+std::string FixedOrDash(double value, int digits) {
   if (!std::isfinite(value)) return "-";
   char text[64];
   std::snprintf(text, sizeof(text), "%.*f", digits, value);
@@ -135,10 +135,10 @@ std::string MonteCarloMarkdown(const std::vector<MonteCarloSummary>& summaries) 
       "ANEES orientation (3) |\n|---|---:|---:|---:|---:|---|---:|---:|---:|\n";
   for (const MonteCarloSummary& s : summaries) {
     md += "| " + s.policy + " | " + std::to_string(s.window_size) + " | " + std::to_string(s.runs) + " | " +
-          (s.runs ? Fixed(s.mean_ate_m, 4) : "-") + " | " + (s.runs ? Fixed(s.anees_pose, 2) : "-") + " | " +
-          (s.runs ? "[" + Fixed(s.lower_pose, 2) + ", " + Fixed(s.upper_pose, 2) + "]" : "-") + " | " +
-          (s.runs ? Fixed(100 * s.fraction_in_bounds, 0) + " %" : "-") + " | " +
-          (s.runs ? Fixed(s.anees_position, 2) : "-") + " | " + (s.runs ? Fixed(s.anees_orientation, 2) : "-") +
+          (s.runs ? FixedOrDash(s.mean_ate_m, 4) : "-") + " | " + (s.runs ? FixedOrDash(s.anees_pose, 2) : "-") + " | " +
+          (s.runs ? "[" + FixedOrDash(s.lower_pose, 2) + ", " + FixedOrDash(s.upper_pose, 2) + "]" : "-") + " | " +
+          (s.runs ? FixedOrDash(100 * s.fraction_in_bounds, 0) + " %" : "-") + " | " +
+          (s.runs ? FixedOrDash(s.anees_position, 2) : "-") + " | " + (s.runs ? FixedOrDash(s.anees_orientation, 2) : "-") +
           " |\n";
   }
   return md;
