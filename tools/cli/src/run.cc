@@ -278,10 +278,21 @@ void Evaluate(const EurocDataset& dataset, const RunRequest& request, const RunO
              PathLength(dataset.groundtruth, estimated.front().t_ns, estimated.back().t_ns), result);
 }
 
+// Valid settings that usually give a worse estimate than the user wants: a warning each.
+void WarnAboutQuestionableSettings(const RunConfig& config) {
+  const int kept = config.estimator.persistent.persistent_landmarks;
+  if (kept > 0 && !config.estimator.model.fej) {
+    LOG(WARNING) << "--persistent_landmarks=" << kept
+                 << " without --fej=true: the kept landmarks' relinearized observations disagree with the prior "
+                    "they are in, which usually makes the estimate worse (README: Long-lived landmarks)";
+  }
+}
+
 }  // namespace
 
 RunResult RunDataset(const RunRequest& requested) {
   ValidateRunConfig(requested.config);
+  WarnAboutQuestionableSettings(requested.config);
   const EurocDataset dataset = ReadRunDataset(requested);
   RunRequest request = requested;
   request.config.frontend.frontend = ResolveFrontend(requested.config.frontend.frontend, dataset);
