@@ -35,6 +35,7 @@ import numpy as np  # noqa: E402
 
 DPI = 90
 ALIGNMENT = "estimates aligned to the ground truth in position + yaw"
+DATASET_FILLS = ("full", "none", "left", "bottom")  # ATE-against-cost marker fill per dataset
 GROUND_TRUTH = {"color": "0.55", "lw": 5.0, "alpha": 0.45, "solid_capstyle": "round", "zorder": 1}
 POLICY_LOOKS = [("o", "-"), ("s", "--"), ("^", "-."), ("D", ":"), ("v", (0, (5, 1, 1, 1))), ("P", (0, (1, 1)))]
 
@@ -214,17 +215,26 @@ def plot_ate_vs_cost(rows, styles, out_path):
         return False
     datasets = sorted({d for d, _ in series})
     fig, ax = plt.subplots(figsize=(9, 4.8))
+    labelled = set()
     for (dataset, policy), points in sorted(series.items()):
         points.sort(key=lambda p: p[2])
         costs, ates, windows = zip(*points)
         look = styles[(policy, windows[0])]
-        name = policy if len(datasets) == 1 else f"{dataset} {policy}"
+        fill = DATASET_FILLS[datasets.index(dataset) % len(DATASET_FILLS)]
         ax.plot(costs, ates, color="0.6", ls=look["ls"], lw=1.0, zorder=1)
         for cost, ate, window in points:
             s = styles[(policy, window)]
+            label = run_label(policy, window)
             ax.plot([cost], [ate], ls="none", marker=s["marker"], ms=8, color=s["color"], zorder=3,
-                    label=f"{name} w={window}")
+                    fillstyle=fill, mfcalt="white", mew=1.5,
+                    label=None if label in labelled else label)
+            labelled.add(label)
             ax.annotate(f"w={window}", (cost, ate), textcoords="offset points", xytext=(6, 5), fontsize=8)
+    if len(datasets) > 1:
+        for i, dataset in enumerate(datasets):
+            fill = DATASET_FILLS[i % len(DATASET_FILLS)]
+            ax.plot([], [], ls="none", marker="o", ms=8, color="black", fillstyle=fill,
+                    mfcalt="white", mew=1.5, label=dataset)
     costs = [c for points in series.values() for c, _, _ in points]
     ates = [a for points in series.values() for _, a, _ in points]
     ax.set_xscale("log")

@@ -14,6 +14,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
+#include "vio/estimator/chain_solve.h"
 #include "vio/marginalization/linear_algebra.h"
 #include "vio/marginalization/marginalization_prior.h"
 
@@ -115,6 +116,9 @@ struct GaussNewtonSolver::System {
   int dense_dim = 0;
   std::vector<EliminatedBlock> eliminated;
   std::vector<Residual> residuals;
+  std::vector<ChainBlock> chain;  ///< empty: solve densely
+  int chain_bandwidth = 0;
+  ChainSolver chain_solver;
   // Buffers reused by every step.
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
@@ -159,6 +163,34 @@ struct GaussNewtonSolver::System {
       }
     }
     jacobians.resize(scratch);
+    FindChain();
+  }
+
+  // The chain's bandwidth: the widest gap in chain order between two chain
+  // blocks that one residual, or one eliminated block's Schur update, couples.
+  // Used when the band is narrow enough to beat the dense solve.
+  void FindChain() {
+    std::vector<int> position(dense.size(), -1);
+    for (size_t k = 0; k < layout.chain.size(); ++k) position[layout.chain[k]] = static_cast<int>(k);
+    const auto widen = [&](const auto& dense_blocks) {
+      int low = -1;
+      int high = -1;
+      for (const int d : dense_blocks) {
+        if (d < 0 || position[d] < 0) continue;
+        low = low < 0 ? position[d] : std::min(low, position[d]);
+        high = std::max(high, position[d]);
+      }
+      chain_bandwidth = std::max(chain_bandwidth, high - low);
+    };
+    for (const Residual& residual : residuals) {
+      std::vector<int> blocks;
+      for (const Slot& slot : residual.slots) blocks.push_back(slot.dense);
+      widen(blocks);
+    }
+    for (const EliminatedBlock& block : eliminated) widen(block.coupled);
+    const int m = static_cast<int>(layout.chain.size());
+    if (m < 2 || 4 * (chain_bandwidth + 1) > m) return;
+    for (const int d : layout.chain) chain.push_back({dense[d].offset, dense[d].size});
   }
 
   // The residual's slots; returns the scratch its Jacobians need.
@@ -387,7 +419,8 @@ struct GaussNewtonSolver::System {
     GaussNewtonStep step;
     if (!Reduce(&step.cost)) return step;
     Eigen::VectorXd dx_dense;
-    if (!SolveDense(H, b, &dx_dense)) return step;
+    const bool chained = !chain.empty() && chain_solver.Solve(H, b, chain, chain_bandwidth, &dx_dense);
+    if (!chained && !SolveDense(H, b, &dx_dense)) return step;
     Eigen::VectorXd dx(dense_dim + (eliminated.empty() ? 0 : eliminated.back().columns.offset +
                                                                    eliminated.back().columns.size - dense_dim));
     dx.head(dense_dim) = dx_dense;

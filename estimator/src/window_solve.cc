@@ -31,7 +31,8 @@ std::vector<ceres::ResidualBlockId> Window::ResidualOrder() const {
 }
 
 // Dense columns: every pose, then every speed/bias block (both by state id),
-// then the landmarks tied by a prior. With the poses side by side, the poses
+// then the landmarks tied by a prior; the speed/bias blocks are the chain the
+// solver may eliminate first (gauss_newton.h). With the poses side by side, the poses
 // seeing a landmark are one contiguous range of columns (a track is seen from
 // consecutive states), so its Schur update is one rank-3 update in place.
 GaussNewtonLayout Window::Layout() const {
@@ -43,7 +44,9 @@ GaussNewtonLayout Window::Layout() const {
     if (variable(s.pose)) layout.dense.push_back(const_cast<double*>(s.pose));
   }
   for (const auto& [id, s] : states_) {
-    if (variable(s.speed_bias)) layout.dense.push_back(const_cast<double*>(s.speed_bias));
+    if (!variable(s.speed_bias)) continue;
+    layout.chain.push_back(static_cast<int>(layout.dense.size()));
+    layout.dense.push_back(const_cast<double*>(s.speed_bias));
   }
   for (const auto& [id, landmark] : landmarks_) {
     if (!variable(landmark.p_w)) continue;

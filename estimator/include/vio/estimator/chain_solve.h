@@ -1,0 +1,54 @@
+#pragma once
+// The dense Gauss-Newton system with a chain of blocks solved first (paper
+// §2.2's normal equations, factored in a cheaper order). After the landmarks
+// are Schur-eliminated, the speed/bias blocks of a window couple only through
+// the IMU factors between consecutive states: their part of H is block-banded.
+// Eliminating them first by a block-banded Cholesky leaves a Schur complement
+// over the poses (and prior-tied landmarks) only, so the cubic dense work is
+// over 6k columns instead of 15k for a window of k states. The solution is the
+// same as a dense Cholesky of the whole system up to round-off.
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+namespace vio {
+
+/// The columns of one block of the chain.
+struct ChainBlock {
+  int offset = 0;
+  int size = 0;
+};
+
+/// Solves H dx = -b, H symmetric positive definite given by its upper
+/// triangle, with the `chain` blocks (in chain order, ascending columns)
+/// eliminated first. `bandwidth`: no entry of H couples chain blocks more than
+/// this many places apart in the chain. Keeps its buffers between solves (a
+/// window's Gauss-Newton steps solve systems of one shape).
+class ChainSolver {
+ public:
+  /// False when a factor is not positive definite (the caller falls back to a
+  /// dense solve); `dx` is then unspecified.
+  bool Solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, const std::vector<ChainBlock>& chain, int bandwidth,
+             Eigen::VectorXd* dx);
+
+ private:
+  bool FactorChain(const Eigen::MatrixXd& H, const std::vector<ChainBlock>& chain);
+  void ForwardSolve(Eigen::Ref<Eigen::MatrixXd> r) const;
+  void BackwardSolve(Eigen::Ref<Eigen::VectorXd> z) const;
+  const Eigen::MatrixXd& L(int i, int j) const { return below_[i][i - j - 1]; }
+  int First(int i) const { return i - bandwidth_ > 0 ? i - bandwidth_ : 0; }
+
+  int bandwidth_ = 0;
+  std::vector<int> rows_;  ///< first row of each chain block among the chain's columns
+  std::vector<int> rest_;  ///< the columns not in the chain, ascending
+  std::vector<Eigen::LLT<Eigen::MatrixXd>> diagonal_;  ///< L(i, i) L(i, i)^T
+  std::vector<std::vector<Eigen::MatrixXd>> below_;    ///< below_[i][i - j - 1] = L(i, j), j < i in the band
+  Eigen::MatrixXd X_;  ///< L^-1 H_chain,rest
+  Eigen::MatrixXd S_;  ///< H_rest,rest - X^T X (upper triangle)
+  Eigen::VectorXd y_;  ///< L^-1 b_chain
+  Eigen::VectorXd dx_rest_;
+  Eigen::VectorXd z_;
+};
+
+}  // namespace vio

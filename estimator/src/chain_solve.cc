@@ -1,0 +1,115 @@
+#include "vio/estimator/chain_solve.h"
+
+#include <algorithm>
+
+namespace vio {
+namespace {
+
+/// H(r, c) of a symmetric matrix stored in its upper triangle.
+double UpperEntry(const Eigen::MatrixXd& H, int r, int c) { return r <= c ? H(r, c) : H(c, r); }
+
+/// H's block (a, b) of a symmetric matrix stored in its upper triangle, for
+/// a.offset < b.offset or a == b.
+Eigen::MatrixXd UpperBlock(const Eigen::MatrixXd& H, const ChainBlock& a, const ChainBlock& b) {
+  if (a.offset == b.offset) return H.block(a.offset, a.offset, a.size, a.size).selfadjointView<Eigen::Upper>();
+  return H.block(a.offset, b.offset, a.size, b.size);
+}
+
+}  // namespace
+
+// Block-banded Cholesky H_cc = L L^T, block row by block row.
+bool ChainSolver::FactorChain(const Eigen::MatrixXd& H, const std::vector<ChainBlock>& chain) {
+  const int m = static_cast<int>(chain.size());
+  diagonal_.resize(m);
+  below_.resize(m);
+  for (int i = 0; i < m; ++i) {
+    below_[i].resize(static_cast<size_t>(i - First(i)));
+    for (int j = First(i); j < i; ++j) {
+      Eigen::MatrixXd a = UpperBlock(H, chain[j], chain[i]).transpose();
+      for (int k = std::max(First(i), First(j)); k < j; ++k) a.noalias() -= L(i, k) * L(j, k).transpose();
+      // L(i, j) L(j, j)^T = a
+      below_[i][i - j - 1] = diagonal_[j].matrixL().solve(a.transpose()).transpose();
+    }
+    Eigen::MatrixXd d = UpperBlock(H, chain[i], chain[i]);
+    for (int k = First(i); k < i; ++k) d.noalias() -= L(i, k) * L(i, k).transpose();
+    diagonal_[i].compute(d);
+    if (diagonal_[i].info() != Eigen::Success) return false;
+  }
+  return true;
+}
+
+// r <- L^-1 r, r with one row block per chain block.
+void ChainSolver::ForwardSolve(Eigen::Ref<Eigen::MatrixXd> r) const {
+  for (int i = 0; i < static_cast<int>(diagonal_.size()); ++i) {
+    const int size = static_cast<int>(diagonal_[i].rows());
+    for (int k = First(i); k < i; ++k) {
+      r.middleRows(rows_[i], size).noalias() -= L(i, k) * r.middleRows(rows_[k], L(i, k).cols());
+    }
+    diagonal_[i].matrixL().solveInPlace(r.middleRows(rows_[i], size));
+  }
+}
+
+// z <- L^-T z.
+void ChainSolver::BackwardSolve(Eigen::Ref<Eigen::VectorXd> z) const {
+  const int m = static_cast<int>(diagonal_.size());
+  for (int i = m - 1; i >= 0; --i) {
+    const int size = static_cast<int>(diagonal_[i].rows());
+    for (int k = i + 1; k < std::min(m, i + bandwidth_ + 1); ++k) {
+      z.segment(rows_[i], size).noalias() -= L(k, i).transpose() * z.segment(rows_[k], L(k, i).rows());
+    }
+    diagonal_[i].matrixU().solveInPlace(z.segment(rows_[i], size));
+  }
+}
+
+// With H_cc = L L^T, X = L^-1 H_cr and y = L^-1 b_c: the rest solves
+// (H_rr - X^T X) dx_r = -(b_r - X^T y), then L^T dx_c = -(y + X dx_r).
+bool ChainSolver::Solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, const std::vector<ChainBlock>& chain,
+                        int bandwidth, Eigen::VectorXd* dx) {
+  const int n = static_cast<int>(H.rows());
+  bandwidth_ = bandwidth;
+  rows_.clear();
+  std::vector<int> chain_columns;
+  std::vector<bool> in_chain(static_cast<size_t>(n), false);
+  for (const ChainBlock& block : chain) {
+    rows_.push_back(static_cast<int>(chain_columns.size()));
+    for (int c = block.offset; c < block.offset + block.size; ++c) {
+      chain_columns.push_back(c);
+      in_chain[c] = true;
+    }
+  }
+  rest_.clear();
+  for (int c = 0; c < n; ++c) {
+    if (!in_chain[c]) rest_.push_back(c);
+  }
+  if (!FactorChain(H, chain)) return false;
+  const int nc = static_cast<int>(chain_columns.size());
+  const int nr = static_cast<int>(rest_.size());
+  X_.resize(nc, nr);
+  S_.resize(nr, nr);
+  for (int j = 0; j < nr; ++j) {
+    for (int i = 0; i < nc; ++i) X_(i, j) = UpperEntry(H, chain_columns[i], rest_[j]);
+    for (int i = 0; i <= j; ++i) S_(i, j) = H(rest_[i], rest_[j]);
+  }
+  y_ = b(chain_columns);
+  ForwardSolve(X_);
+  ForwardSolve(y_);
+  S_.selfadjointView<Eigen::Upper>().rankUpdate(X_.transpose(), -1.0);
+  dx_rest_.resize(nr);
+  if (nr > 0) {
+    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Upper> llt(S_);  // in place
+    if (llt.info() != Eigen::Success) return false;
+    dx_rest_.noalias() = X_.transpose() * y_;
+    dx_rest_ -= b(rest_);
+    llt.solveInPlace(dx_rest_);
+  }
+  z_ = y_;
+  z_.noalias() += X_ * dx_rest_;
+  z_ = -z_;
+  BackwardSolve(z_);
+  dx->resize(n);
+  (*dx)(chain_columns) = z_;
+  (*dx)(rest_) = dx_rest_;
+  return dx->allFinite();
+}
+
+}  // namespace vio
