@@ -122,6 +122,8 @@ struct GaussNewtonSolver::System {
   // Buffers reused by every step.
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
+  // The layout's values before the last step, dense then eliminated blocks.
+  std::vector<double> before_step;
   std::vector<double> r;
   std::vector<double> jacobians;
   std::vector<double*> jacobian_pointers;
@@ -415,6 +417,27 @@ struct GaussNewtonSolver::System {
     return true;
   }
 
+  void SaveValues() {
+    before_step.clear();
+    for (const std::vector<double*>* blocks : {&layout.dense, &layout.eliminated}) {
+      for (const double* block : *blocks) {
+        before_step.insert(before_step.end(), block, block + problem->ParameterBlockSize(block));
+      }
+    }
+  }
+
+  void RestoreValues() const {
+    CHECK(!before_step.empty()) << "UndoStep without a step";
+    auto value = before_step.begin();
+    for (const std::vector<double*>* blocks : {&layout.dense, &layout.eliminated}) {
+      for (double* block : *blocks) {
+        const int size = problem->ParameterBlockSize(block);
+        std::copy(value, value + size, block);
+        value += size;
+      }
+    }
+  }
+
   GaussNewtonStep Step() {
     GaussNewtonStep step;
     if (!Reduce(&step.cost)) return step;
@@ -435,6 +458,7 @@ struct GaussNewtonSolver::System {
     if (!dx.allFinite()) return step;
     step.values_norm = std::sqrt(SquaredNorm(*problem, layout.dense) + SquaredNorm(*problem, layout.eliminated));
     step.step_norm = dx.norm();
+    SaveValues();
     ApplyStep(problem, layout.dense, dx, 0);
     ApplyStep(problem, layout.eliminated, dx, dense_dim);
     step.ok = true;
@@ -448,6 +472,8 @@ GaussNewtonSolver::GaussNewtonSolver(ceres::Problem* problem, GaussNewtonLayout 
 GaussNewtonSolver::~GaussNewtonSolver() = default;
 
 GaussNewtonStep GaussNewtonSolver::Step() { return system_->Step(); }
+
+void GaussNewtonSolver::UndoStep() { system_->RestoreValues(); }
 
 // As Ceres evaluates a residual block's cost (0.5 rho(|r|^2), invalid when
 // not finite) without its per-call bookkeeping.

@@ -162,8 +162,12 @@ SolveReport Window::GaussNewton(int max_steps, bool until_converged, const Solve
     ++report.iterations;
     double cost = 0;
     if (!solver.Cost(&cost)) {
-      report.usable = false;
-      ++health_.failed_solves;
+      // An undamped step can overshoot a residual out of its domain (a
+      // landmark moved behind a camera): keeping it would leave every later
+      // solve unable to linearize until that residual left the window.
+      solver.UndoStep();
+      ++health_.rejected_steps;
+      LOG(WARNING) << "gauss-newton: step " << k << " reached a point that does not evaluate; undone";
       break;
     }
     report.final_cost = cost;

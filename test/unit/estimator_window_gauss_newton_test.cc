@@ -16,6 +16,7 @@
 #include "estimator_test_support.h"
 #include "synthetic_window.h"
 #include "vio/estimator/gauss_newton.h"
+#include "vio/estimator/stereo_factor.h"
 #include "vio/estimator/window.h"
 
 namespace vio {
@@ -230,6 +231,44 @@ TEST(WindowGaussNewton, SolveStopsByTheConvergenceCriterionNotTheCap) {
   // At the optimum a further step does not lower the cost.
   const SolveReport further = window.TakeSteps(1, gn);
   EXPECT_GE(further.final_cost, further.initial_cost * (1 - 1e-9));
+}
+
+// An undamped step can overshoot a landmark out of the stereo factor's domain:
+// a landmark estimated at ten times the depth its disparity says is stepped
+// to far behind the camera. The window must undo such a step (else every
+// later solve fails to linearize until the observation leaves the window).
+TEST(WindowGaussNewton, AStepThatMovesALandmarkBehindTheCameraIsUndone) {
+  constexpr int kStates = 3;
+  Window window(Model(), Flight().stereo());
+  Flight().Build(window, Model(), kFirst, kStates);
+  const StateId last(kStates - 1);
+  const State& state = window.state(last);
+  const Landmark* seen = nullptr;
+  for (const auto& [id, landmark] : window.landmarks()) {
+    if (landmark.observed_from.count(last)) seen = &landmark;
+  }
+  ASSERT_NE(seen, nullptr);
+  Eigen::Vector3d z_px;
+  ASSERT_TRUE(StereoFactor::Project(Flight().stereo(), state.p_w_b(), state.q_w_b(), seen->position(), &z_px));
+  const LandmarkId far(1000000);
+  window.AddLandmark(far, state.p_w_b() + 10 * (seen->position() - state.p_w_b()));
+  window.AddObservation(last, far, z_px);
+  const double* far_block = window.landmark(far).p_w;
+  const auto before = Values(window.problem());
+  const std::vector<double>& stepped = ClosedFormStep(window.problem()).at(far_block);
+  ASSERT_FALSE(StereoFactor::Project(Flight().stereo(), state.p_w_b(), state.q_w_b(),
+                                     Eigen::Vector3d(stepped[0], stepped[1], stepped[2]), &z_px))
+      << "the step should end behind the camera";
+
+  SolverOptions gn;
+  gn.step = "gn";
+  const SolveReport report = window.TakeSteps(1, gn);
+  EXPECT_TRUE(report.usable);
+  EXPECT_EQ(window.health().rejected_steps, 1);
+  EXPECT_EQ(window.health().failed_solves, 0);
+  EXPECT_EQ(LargestDifference(Values(window.problem()), before), 0.0);
+  double cost = 0;
+  EXPECT_TRUE(window.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr));
 }
 
 }  // namespace

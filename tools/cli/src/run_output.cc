@@ -43,7 +43,8 @@ std::string HealthJson(const RunHealth& h) {
   os << "{\"frames_waiting_init\": " << h.frames_waiting_init << ", \"frames_before_imu\": " << h.frames_before_imu << ", \"frames_after_imu\": " << h.frames_after_imu
      << ", \"frames_after_stop\": " << h.frames_after_stop
      << ", \"rejected_observations\": " << h.rejected_observations
-     << ", \"dropped_residuals\": " << h.dropped_residuals << ", \"failed_solves\": " << h.failed_solves << "}";
+     << ", \"dropped_residuals\": " << h.dropped_residuals << ", \"failed_solves\": " << h.failed_solves
+     << ", \"rejected_steps\": " << h.rejected_steps << "}";
   return os.str();
 }
 

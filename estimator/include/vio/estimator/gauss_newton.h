@@ -3,7 +3,8 @@
 // residual at the current values (Problem::Evaluate: loss functions applied as
 // Ceres applies them, Jacobians on the tangent spaces), solve the normal
 // equations J^T J dx = -J^T r without damping, and apply x <- x ⊞ dx. The step
-// is always taken: no trust region, no line search, no rejected steps.
+// is always taken: no trust region, no line search; the caller may only undo a
+// step whose end point does not evaluate (UndoStep).
 //
 // The columns are laid out by the caller (the window: states and landmarks by
 // id), never by address, so the result does not depend on the heap layout.
@@ -73,6 +74,9 @@ class GaussNewtonSolver {
 
   /// One undamped step on the layout's blocks (see TakeGaussNewtonStep).
   GaussNewtonStep Step();
+  /// Restores the values from before the last successful Step() (for a step
+  /// whose end point does not evaluate, e.g. a landmark moved behind a camera).
+  void UndoStep();
   /// 1/2 |r|^2 at the current values (see EvaluateCost).
   bool Cost(double* cost);
   /// The reduced system at the current values (see ReducedNormalEquations).

@@ -77,6 +77,7 @@ struct Removals {
 struct WindowHealth {
   int dropped_residuals = 0;  ///< residuals that did not evaluate (or not finitely) when marginalized: dropped
   int failed_solves = 0;      ///< solves whose result Ceres reported unusable
+  int rejected_steps = 0;     ///< Gauss-Newton steps undone: their end point did not evaluate
 };
 
 class Window {

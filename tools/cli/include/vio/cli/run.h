@@ -38,6 +38,7 @@ struct RunHealth {
   int rejected_observations = 0;  ///< observations beyond the whitened-residual gate
   int dropped_residuals = 0;      ///< residuals that did not evaluate at marginalization
   int failed_solves = 0;          ///< solves without a usable solution
+  int rejected_steps = 0;         ///< Gauss-Newton steps undone: their end point did not evaluate
 };
 
 struct RunResult {
