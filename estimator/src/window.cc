@@ -302,6 +302,24 @@ std::set<ceres::ResidualBlockId> Window::DropUnevaluableResiduals(const std::vec
   return dropped;
 }
 
+std::vector<Window::ObservationKey> Window::UnevaluableObservations() const {
+  std::vector<ObservationKey> failing;
+  for (const auto& [key, observation] : observations_) {
+    if (!EvaluatesFinitely(*problem_, observation.residual)) failing.push_back(key);
+  }
+  return failing;
+}
+
+void Window::DropOutlierObservations(const std::vector<ObservationKey>& observations) {
+  const std::set<const double*> held = BlocksInPriors();
+  for (const auto& [state_id, landmark_id] : observations) {
+    DropObservation(state_id, landmark_id);
+    ++health_.dropped_observations;
+    const Landmark& l = landmarks_.at(landmark_id);
+    if (l.observed_from.empty() && held.count(l.p_w) == 0) DropLandmark(landmark_id);
+  }
+}
+
 void Window::RemoveStateBookkeeping(StateId id) { states_.erase(id); }
 
 void Window::DropObservation(StateId state_id, LandmarkId landmark_id) {

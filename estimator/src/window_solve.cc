@@ -148,28 +148,36 @@ SolveReport Window::TakeSteps(int steps, const SolverOptions& options) {
   return LevenbergMarquardt(solver, options);
 }
 
+// Undamped steps. A step whose end point does not evaluate (it overshot a
+// landmark behind a camera: a depth far from what its disparity says) is
+// undone, the observations that failed there are dropped as outliers, and the
+// step is taken again on the window without them; it does not count as one of
+// the `max_steps`.
 SolveReport Window::GaussNewton(int max_steps, bool until_converged, const SolverOptions& options) {
   SolveReport report;
-  GaussNewtonSolver solver(problem_.get(), Layout());
+  auto solver = std::make_unique<GaussNewtonSolver>(problem_.get(), Layout());
   for (int k = 0; k < max_steps; ++k) {
-    const GaussNewtonStep step = solver.Step();
+    const GaussNewtonStep step = solver->Step();
     if (k == 0) report.initial_cost = report.final_cost = step.cost;
     if (!step.ok) {
       report.usable = false;
       ++health_.failed_solves;
       break;
     }
-    ++report.iterations;
     double cost = 0;
-    if (!solver.Cost(&cost)) {
-      // An undamped step can overshoot a residual out of its domain (a
-      // landmark moved behind a camera): keeping it would leave every later
-      // solve unable to linearize until that residual left the window.
-      solver.UndoStep();
+    if (!solver->Cost(&cost)) {
+      const std::vector<ObservationKey> outliers = UnevaluableObservations();
+      solver->UndoStep();
       ++health_.rejected_steps;
-      LOG(WARNING) << "gauss-newton: step " << k << " reached a point that does not evaluate; undone";
-      break;
+      LOG(WARNING) << "gauss-newton: step " << k << " reached a point that does not evaluate; undone, "
+                   << outliers.size() << " observation(s) that fail there dropped";
+      if (outliers.empty()) break;
+      DropOutlierObservations(outliers);
+      solver = std::make_unique<GaussNewtonSolver>(problem_.get(), Layout());
+      --k;
+      continue;
     }
+    ++report.iterations;
     report.final_cost = cost;
     VLOG(2) << "gn step " << k << ": cost " << step.cost << " -> " << cost << ", |dx| " << step.step_norm;
     const bool small_change = std::abs(step.cost - cost) <= options.function_tolerance * step.cost;

@@ -210,6 +210,20 @@ void Solve(ceres::Problem* problem) {
   EXPECT_TRUE(summary.IsSolutionUsable()) << summary.BriefReport();
 }
 
+// The remaining problem's information on `kept` equals the exact Gaussian
+// marginal's, and solving it gives the exact marginal mean.
+void ExpectExactMarginalOf(LinearModel* model, ceres::Problem* problem, const std::vector<int>& kept) {
+  Eigen::MatrixXd exact_information;
+  Eigen::VectorXd exact_mean;
+  model->ExactMarginal(kept, &exact_information, &exact_mean);
+  std::vector<double*> kept_blocks;
+  for (const int v : kept)
+    kept_blocks.push_back(model->block(v));
+  EXPECT_LT(RelativeError(ProblemInformation(problem, kept_blocks), exact_information), 1e-9);
+  Solve(problem);
+  EXPECT_LT(RelativeError(model->Values(kept), exact_mean), 1e-9);
+}
+
 // Five chained Euclidean blocks with a loop factor; blocks 0 and 1 go.
 class LinearChainTest : public ::testing::Test {
  protected:
@@ -330,19 +344,42 @@ TEST(MarginalizeBlocks, FrameWithItsLandmarksIsExact) {
   }
   ceres::Problem problem;
   model.AddAllToProblem(&problem);
-  const std::vector<int> kept = {f1, f2, landmarks[3], landmarks[4], landmarks[5]};
-  Eigen::MatrixXd exact_information;
-  Eigen::VectorXd exact_mean;
-  model.ExactMarginal(kept, &exact_information, &exact_mean);
-
   MarginalizeBlocks(&problem, {model.block(f0), model.block(landmarks[0]),
                                model.block(landmarks[1]), model.block(landmarks[2])});
-  std::vector<double*> kept_blocks;
-  for (const int v : kept)
-    kept_blocks.push_back(model.block(v));
-  EXPECT_LT(RelativeError(ProblemInformation(&problem, kept_blocks), exact_information), 1e-9);
-  Solve(&problem);
-  EXPECT_LT(RelativeError(model.Values(kept), exact_mean), 1e-9);
+  ExpectExactMarginalOf(&model, &problem, {f1, f2, landmarks[3], landmarks[4], landmarks[5]});
+}
+
+// A prior wide enough that its rows take the dense path (more than 64
+// nonzeros: it spans five 15-dimensional frames) is folded into the next
+// marginalization, whose blanket also holds landmarks the prior does not
+// touch: the dense product covers only the prior's columns.
+TEST(MarginalizeBlocks, WidePriorFoldedIntoABlanketWithLandmarksIsExact) {
+  LinearModel model(17);
+  std::vector<int> frames;
+  for (int i = 0; i < 6; ++i)
+    frames.push_back(model.AddVariable(15));
+  std::vector<int> landmarks;
+  for (int j = 0; j < 8; ++j)
+    landmarks.push_back(model.AddVariable(3));
+  model.AddFactor({frames[0]}, 15);
+  for (int i = 0; i + 1 < 6; ++i)
+    model.AddFactor({frames[i], frames[i + 1]}, 15);
+  model.AddFactor({frames[0], frames[2], frames[3], frames[4], frames[5]}, 20);
+  for (int j = 0; j < 8; ++j) {
+    for (const int frame : {frames[1], frames[j % 2 == 0 ? 3 : 5]})
+      model.AddFactor({frame, landmarks[j]}, 3);
+  }
+  ceres::Problem problem;
+  model.AddAllToProblem(&problem);
+  std::vector<int> kept = {frames[2], frames[3], frames[4], frames[5]};
+  kept.insert(kept.end(), landmarks.begin(), landmarks.end());
+  const ceres::ResidualBlockId wide = MarginalizeBlocks(&problem, {model.block(frames[0])});
+  ASSERT_NE(wide, nullptr);
+  std::vector<double*> spanned;
+  problem.GetParameterBlocksForResidualBlock(wide, &spanned);
+  ASSERT_EQ(spanned.size(), 5u);  // frames 1-5: 75 columns, a dense row
+  MarginalizeBlocks(&problem, {model.block(frames[1])});
+  ExpectExactMarginalOf(&model, &problem, kept);
 }
 
 TEST(MarginalizeBlocks, EmptyBlanketRemovesTheBlockAndAddsNoPrior) {

@@ -225,6 +225,7 @@ void FinishStatus(const Estimator& estimator, RunResult* result) {
   result->health.dropped_residuals = estimator.window().health().dropped_residuals;
   result->health.failed_solves = estimator.window().health().failed_solves;
   result->health.rejected_steps = estimator.window().health().rejected_steps;
+  result->health.dropped_observations = estimator.window().health().dropped_observations;
   if (result->frames_estimated == 0 && result->status == "ok") result->status = "not_initialized";
   if (result->health.failed_solves > 0) {
     result->problems.push_back(std::to_string(result->health.failed_solves) +

@@ -44,7 +44,8 @@ std::string HealthJson(const RunHealth& h) {
      << ", \"frames_after_stop\": " << h.frames_after_stop
      << ", \"rejected_observations\": " << h.rejected_observations
      << ", \"dropped_residuals\": " << h.dropped_residuals << ", \"failed_solves\": " << h.failed_solves
-     << ", \"rejected_steps\": " << h.rejected_steps << "}";
+     << ", \"rejected_steps\": " << h.rejected_steps << ", \"dropped_observations\": " << h.dropped_observations
+     << "}";
   return os.str();
 }
 

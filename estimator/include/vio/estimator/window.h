@@ -78,6 +78,7 @@ struct WindowHealth {
   int dropped_residuals = 0;  ///< residuals that did not evaluate (or not finitely) when marginalized: dropped
   int failed_solves = 0;      ///< solves whose result Ceres reported unusable
   int rejected_steps = 0;     ///< Gauss-Newton steps undone: their end point did not evaluate
+  int dropped_observations = 0;  ///< observations that did not evaluate at a rejected step's end point: dropped
 };
 
 class Window {
@@ -199,6 +200,10 @@ class Window {
   void ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const;
   void ForgetResidualsOf(const std::set<const double*>& removed_blocks);
   std::set<ceres::ResidualBlockId> DropUnevaluableResiduals(const std::vector<double*>& blocks);
+  /// The observations whose residual does not evaluate (finitely) at the current values, by ids.
+  std::vector<ObservationKey> UnevaluableObservations() const;
+  /// Drops `observations`, and a landmark left unobserved that no prior holds.
+  void DropOutlierObservations(const std::vector<ObservationKey>& observations);
   void RemoveStateBookkeeping(StateId id);
   /// FEJ (model.fej): `factor` wrapped to take its Jacobians on held blocks at
   /// their first estimates; `factor` itself without FEJ.

@@ -39,6 +39,7 @@ struct RunHealth {
   int dropped_residuals = 0;      ///< residuals that did not evaluate at marginalization
   int failed_solves = 0;          ///< solves without a usable solution
   int rejected_steps = 0;         ///< Gauss-Newton steps undone: their end point did not evaluate
+  int dropped_observations = 0;   ///< observations that failed at a rejected step's end point: dropped as outliers
 };
 
 struct RunResult {
