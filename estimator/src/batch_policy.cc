@@ -49,7 +49,7 @@ bool BatchPolicy::Finish(Window& window) {
   for (const auto& [id, landmark] : window.landmarks()) window.SetLandmarkConstant(id, false);
   SolverOptions solver = options_.solver;
   solver.max_iterations = options_.batch.batch_final_iterations;
-  // Ceres' own tolerance: the default function_tolerance (1e-4) is set for
+  // Ceres' own tolerance: the default function_tolerance (1e-3) is set for
   // the Gauss-Newton steps of a window, not for the final solve of everything.
   solver.function_tolerance = 1e-6;
   solver.max_solver_time_s = 3600;

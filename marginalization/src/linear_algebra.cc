@@ -45,6 +45,23 @@ Eigen::MatrixXd SymmetricPart(const Eigen::MatrixXd& H) {
   return 0.5 * (H + H.transpose());
 }
 
+/// Eigenvalues at or below this are dropped as zero.
+double EigenvalueCutoff(double largest_eigenvalue, const RankThreshold& threshold) {
+  return std::max(threshold.absolute, threshold.relative * std::max(largest_eigenvalue, 0.0));
+}
+
+/// PseudoInverse of a 3x3 block (every landmark of a Schur elimination) on
+/// fixed-size matrices, without heap allocation: the same decomposition and
+/// cutoff as DecomposeSignificant.
+Eigen::Matrix3d PseudoInverse3(const Eigen::Matrix3d& H, const RankThreshold& threshold) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(0.5 * (H + H.transpose()));
+  CHECK(solver.info() == Eigen::Success) << "eigen-decomposition of a finite symmetric matrix failed";
+  const Eigen::Vector3d& lambda = solver.eigenvalues();
+  const double cutoff = EigenvalueCutoff(lambda.maxCoeff(), threshold);
+  const Eigen::Vector3d inverse = (lambda.array() > cutoff).select(lambda.cwiseInverse(), 0.0);
+  return solver.eigenvectors() * inverse.asDiagonal() * solver.eigenvectors().transpose();
+}
+
 SignificantEigenpairs DecomposeSignificant(const Eigen::MatrixXd& H,
                                            const RankThreshold& threshold) {
   SignificantEigenpairs result;
@@ -55,8 +72,7 @@ SignificantEigenpairs DecomposeSignificant(const Eigen::MatrixXd& H,
   CHECK(solver.info() == Eigen::Success)
       << "eigen-decomposition of a finite symmetric matrix failed";
   const Eigen::VectorXd& lambda = solver.eigenvalues();  // ascending
-  const double cutoff =
-      std::max(threshold.absolute, threshold.relative * std::max(lambda.maxCoeff(), 0.0));
+  const double cutoff = EigenvalueCutoff(lambda.maxCoeff(), threshold);
   int first_kept = 0;
   while (first_kept < lambda.size() && lambda(first_kept) <= cutoff) {
     ++first_kept;
@@ -123,8 +139,7 @@ SqrtInformation SqrtByPivotedLdlt(const Eigen::MatrixXd& H, const Eigen::VectorX
     return SqrtByEigen(H, b, threshold);
   }
   const Eigen::VectorXd D = ldlt.vectorD();
-  const double cutoff =
-      std::max(threshold.absolute, threshold.relative * std::max(D.maxCoeff(), 0.0));
+  const double cutoff = EigenvalueCutoff(D.maxCoeff(), threshold);
   std::vector<int> kept;
   for (int i = 0; i < n; ++i) {
     if (D(i) > cutoff) {
@@ -152,6 +167,7 @@ Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& H, const RankThreshold& thr
   if (!H.allFinite() || H.rows() != H.cols()) {
     throw std::invalid_argument("PseudoInverse: expected a finite square matrix");
   }
+  if (H.rows() == 3) return PseudoInverse3(H, threshold);
   const SignificantEigenpairs eig = DecomposeSignificant(H, threshold);
   return eig.eigenvectors * eig.eigenvalues.cwiseInverse().asDiagonal() *
          eig.eigenvectors.transpose();

@@ -128,6 +128,24 @@ TEST(PseudoInverse, SatisfiesThePenroseConditionsOnARankDeficientMatrix) {
   EXPECT_LT(RelativeError(H_pinv * H * H_pinv, H_pinv), 1e-10);
 }
 
+// 3x3 blocks (landmarks) take a fixed-size path: the inverse at full rank, the
+// Penrose conditions at ranks 2 and 1, and the null directions dropped.
+TEST(PseudoInverse, ThreeByThreeBlocksAtEveryRank) {
+  std::mt19937 rng(8);
+  for (const int rank : {3, 2, 1}) {
+    const Eigen::MatrixXd J = RandomMatrix(rank, 3, &rng);
+    const Eigen::MatrixXd H = J.transpose() * J;
+    const Eigen::MatrixXd H_pinv = PseudoInverse(H);
+    ASSERT_EQ(H_pinv.rows(), 3);
+    EXPECT_LT(RelativeError(H * H_pinv * H, H), 1e-10) << "rank " << rank;
+    EXPECT_LT(RelativeError(H_pinv * H * H_pinv, H_pinv), 1e-10) << "rank " << rank;
+    if (rank == 3) EXPECT_LT(RelativeError(H_pinv, H.inverse()), 1e-10);
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu(J);
+    const Eigen::MatrixXd null_space = lu.kernel();
+    if (rank < 3) EXPECT_LT((H_pinv * null_space).norm(), 1e-10 * H_pinv.norm()) << "rank " << rank;
+  }
+}
+
 class SqrtInformationFromHessianTest : public ::testing::TestWithParam<SqrtMethod> {};
 
 TEST_P(SqrtInformationFromHessianTest, ReproducesFullRankInformationAndVector) {

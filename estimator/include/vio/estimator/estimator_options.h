@@ -122,7 +122,7 @@ struct SolverOptions {
   int max_iterations = 10;        ///< most steps of a to-convergence solve (a safety net) [count]
   double parameter_tolerance = 1e-8;  ///< gn: converged when |dx| <= this * (|x| + this) []
   double max_solver_time_s = 0.0;   ///< wall-time bound per solve [s]; 0 = none (a run that hits one is not reproducible)
-  double function_tolerance = 1e-4;  ///< relative cost change that counts as converged []
+  double function_tolerance = 1e-3;  ///< relative cost change that counts as converged []
   int num_threads = 1;            ///< Ceres threads [count]
   std::string linear_solver = "dense";  ///< dense | sparse (Schur-reduced) | sparse_full (whole system) | iterative
 
