@@ -4,23 +4,18 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include <glog/logging.h>
+
+#include "vio/frontend/segment_test_corners.h"
+
 namespace vio::frontend {
 namespace {
 
 /// The right image keeps this many times brisk_per_cell keypoints per cell.
 constexpr int kRightCellFactor = 3;
-
-// Cross-checked brute-force matches query -> train no further than max_bits.
-std::vector<cv::DMatch> MatchHamming(const cv::BFMatcher& matcher, const cv::Mat& query, const cv::Mat& train,
-                                     int max_bits) {
-  std::vector<cv::DMatch> matches;
-  if (query.empty() || train.empty()) return matches;
-  matcher.match(query, train, matches);
-  matches.erase(std::remove_if(matches.begin(), matches.end(),
-                               [&](const cv::DMatch& m) { return m.distance > static_cast<float>(max_bits); }),
-                matches.end());
-  return matches;
-}
+/// Sub-pixel refinement reads the scores of the 3x3 neighbourhood, whose
+/// circles reach this far [px].
+constexpr int kRefineMarginPx = 4;
 
 Eigen::Vector2d ToEigen(const cv::Point2f& p) { return Eigen::Vector2d(p.x, p.y); }
 
@@ -29,7 +24,6 @@ Eigen::Vector2d ToEigen(const cv::Point2f& p) { return Eigen::Vector2d(p.x, p.y)
 BriskFrontend::BriskFrontend(const FrontendOptions& options, const StereoRectifier& rectifier)
     : StereoFrontend(options, rectifier),
       brisk_(cv::BRISK::create(options.brisk_threshold, options.brisk_octaves)),
-      matcher_(cv::NORM_HAMMING, /*crossCheck=*/true),
       grid_(rectifier.camera_model(0).width(), rectifier.camera_model(0).height(), options.grid_cell_px) {}
 
 std::vector<FrameFeature> BriskFrontend::TrackFrame(const cv::Mat& left, const cv::Mat& right,
@@ -37,11 +31,28 @@ std::vector<FrameFeature> BriskFrontend::TrackFrame(const cv::Mat& left, const c
   std::int64_t start = NowNs();
   // The right image keeps more per cell: its cells hold other scene parts
   // (disparity) than the left image's.
-  const Detections detections[2] = {Detect(left, options().brisk_per_cell),
-                                    Detect(right, kRightCellFactor * options().brisk_per_cell)};
+  Detections detections[2] = {Detect(left, options().brisk_per_cell),
+                              Detect(right, kRightCellFactor * options().brisk_per_cell)};
+  Describe(left, std::vector<bool>(detections[0].keypoints.size(), true), &detections[0]);
   AddTime(&StageTimes::detect_ms, start);
   start = NowNs();
-  StereoFeatures current = MatchStereo(detections[0], detections[1]);
+  MatchCandidates candidates = StereoCandidates(detections[0], detections[1]);
+  // Only right keypoints some left keypoint may match are described.
+  std::vector<bool> wanted(detections[1].keypoints.size(), false);
+  for (const std::vector<int>& list : candidates) {
+    for (int j : list) wanted[static_cast<size_t>(j)] = true;
+  }
+  AddTime(&StageTimes::stereo_ms, start);
+  start = NowNs();
+  Describe(right, wanted, &detections[1]);
+  AddTime(&StageTimes::detect_ms, start);
+  start = NowNs();
+  for (std::vector<int>& list : candidates) {
+    list.erase(std::remove_if(list.begin(), list.end(),
+                              [&](int j) { return !detections[1].described[static_cast<size_t>(j)]; }),
+               list.end());
+  }
+  StereoFeatures current = MatchStereo(detections[0], detections[1], candidates);
   AddTime(&StageTimes::stereo_ms, start);
   start = NowNs();
   MatchTemporal(&current);
@@ -57,16 +68,86 @@ std::vector<FrameFeature> BriskFrontend::TrackFrame(const cv::Mat& left, const c
 
 BriskFrontend::Detections BriskFrontend::Detect(const cv::Mat& image, int per_cell) const {
   std::vector<cv::KeyPoint> all;
-  brisk_->detect(image, all);
+  const bool single_scale = options().brisk_octaves == 0;
+  if (single_scale) {
+    all = DetectSegmentTestCorners(image, options().brisk_threshold);
+  } else {
+    brisk_->detect(image, all);  // multi-scale: BRISK's own scale-space detector
+  }
+  if (single_scale) {
+    // Refined before bucketing: the fitted responses rank the corners of a cell
+    // (integer scores tie often, and ties would be broken by raster order).
+    for (cv::KeyPoint& k : all) {
+      const int x = static_cast<int>(k.pt.x), y = static_cast<int>(k.pt.y);
+      if (x >= kRefineMarginPx && y >= kRefineMarginPx && x < image.cols - kRefineMarginPx &&
+          y < image.rows - kRefineMarginPx) {
+        RefineCorner(image, &k);
+      }
+    }
+  }
   Detections out;
   for (int i : grid_.Bucket(all, per_cell)) out.keypoints.push_back(all[static_cast<size_t>(i)]);
-  brisk_->compute(image, out.keypoints, out.descriptors);
+  out.described.assign(out.keypoints.size(), false);
   return out;
 }
 
-BriskFrontend::StereoFeatures BriskFrontend::MatchStereo(const Detections& left, const Detections& right) {
+void BriskFrontend::Describe(const cv::Mat& image, const std::vector<bool>& wanted, Detections* detections) const {
+  std::vector<int> index;
+  std::vector<cv::KeyPoint> subset;
+  for (size_t i = 0; i < wanted.size(); ++i) {
+    if (!wanted[i]) continue;
+    index.push_back(static_cast<int>(i));
+    subset.push_back(detections->keypoints[i]);
+  }
+  cv::Mat descriptors;
+  brisk_->compute(image, subset, descriptors);
+  detections->descriptors = cv::Mat::zeros(static_cast<int>(detections->keypoints.size()), brisk_->descriptorSize(),
+                                            brisk_->descriptorType());
+  detections->described.assign(detections->keypoints.size(), false);
+  // compute() keeps the keypoints' order and only drops some (too near the
+  // border), so the survivors are found in order.
+  size_t next = 0;
+  for (int r = 0; r < descriptors.rows; ++r) {
+    while (next < index.size() && detections->keypoints[static_cast<size_t>(index[next])].pt != subset[r].pt) ++next;
+    CHECK_LT(next, index.size()) << "BRISK returned a keypoint it was not given";
+    const int i = index[next++];
+    descriptors.row(r).copyTo(detections->descriptors.row(i));
+    detections->described[static_cast<size_t>(i)] = true;
+  }
+}
+
+MatchCandidates BriskFrontend::StereoCandidates(const Detections& left, const Detections& right) const {
+  struct Rectified {
+    double v, u;
+    int index;
+  };
+  std::vector<Rectified> rows;  // the right keypoints by rectified row
+  for (size_t j = 0; j < right.keypoints.size(); ++j) {
+    const std::optional<Eigen::Vector2d> uv = rectifier().Rectify(1, ToEigen(right.keypoints[j].pt));
+    if (uv) rows.push_back({uv->y(), uv->x(), static_cast<int>(j)});
+  }
+  std::sort(rows.begin(), rows.end(), [](const Rectified& a, const Rectified& b) { return a.v < b.v; });
+  const double band = options().max_epipolar_px;
+  MatchCandidates candidates(left.keypoints.size());
+  for (size_t i = 0; i < left.keypoints.size(); ++i) {
+    if (!left.described[i]) continue;
+    const std::optional<Eigen::Vector2d> uv = rectifier().Rectify(0, ToEigen(left.keypoints[i].pt));
+    if (!uv) continue;
+    auto it = std::lower_bound(rows.begin(), rows.end(), uv->y() - band,
+                               [](const Rectified& r, double v) { return r.v < v; });
+    for (; it != rows.end() && it->v <= uv->y() + band; ++it) {
+      if (uv->x() - it->u > 0.0) candidates[i].push_back(it->index);
+    }
+    std::sort(candidates[i].begin(), candidates[i].end());
+  }
+  return candidates;
+}
+
+BriskFrontend::StereoFeatures BriskFrontend::MatchStereo(const Detections& left, const Detections& right,
+                                                         const MatchCandidates& candidates) {
   StereoFeatures out;
-  for (const cv::DMatch& m : MatchHamming(matcher_, left.descriptors, right.descriptors, options().max_hamming_bits)) {
+  for (const cv::DMatch& m :
+       MatchMutualNearest(left.descriptors, right.descriptors, options().max_hamming_bits, &candidates)) {
     const Eigen::Vector2d uv0 = ToEigen(left.keypoints[static_cast<size_t>(m.queryIdx)].pt);
     const Eigen::Vector2d uv1 = ToEigen(right.keypoints[static_cast<size_t>(m.trainIdx)].pt);
     const std::optional<Eigen::Vector3d> z = StereoMeasurement(uv0, uv1);
@@ -98,10 +179,10 @@ void BriskFrontend::MatchTemporal(StereoFeatures* current) const {
   }
   const int max_bits = options().max_hamming_bits;
   std::unordered_map<int, int> left_match;  // current feature -> known track index
-  for (const cv::DMatch& m : MatchHamming(matcher_, current->left_descriptors, known.left_descriptors, max_bits)) {
+  for (const cv::DMatch& m : MatchMutualNearest(current->left_descriptors, known.left_descriptors, max_bits)) {
     left_match[m.queryIdx] = m.trainIdx;
   }
-  for (const cv::DMatch& m : MatchHamming(matcher_, current->right_descriptors, known.right_descriptors, max_bits)) {
+  for (const cv::DMatch& m : MatchMutualNearest(current->right_descriptors, known.right_descriptors, max_bits)) {
     const auto it = left_match.find(m.queryIdx);
     if (it == left_match.end() || it->second != m.trainIdx) continue;
     FrameFeature& f = current->features[static_cast<size_t>(m.queryIdx)];

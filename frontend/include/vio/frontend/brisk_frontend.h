@@ -1,18 +1,24 @@
 #pragma once
 // The paper's front end (§5.2) on BRISK features:
-//   detect    BRISK keypoints in both images, spread by a grid (the
-//             brisk_per_cell strongest per cell in the left image, three
-//             times as many in the right one, whose cells see other scene
-//             parts), and their descriptors;
-//   stereo    brute-force Hamming matching left-right with a cross check,
-//             then the epipolar check on rectified rows (|v_L - v_R| <=
-//             max_epipolar_px, positive disparity); only stereo matches are
-//             kept;
+//   detect    single-scale BRISK keypoints in both images: the segment-test
+//             corners BRISK's detector finds at one scale, with its score
+//             (segment_test_corners.h: FAST computes both 5x faster than
+//             cv::BRISK), spread by a grid (the brisk_per_cell strongest per
+//             cell in the left image, three times as many in the right one,
+//             whose cells see other scene parts), refined to sub-pixel
+//             precision on the score as BRISK does; BRISK descriptors of the
+//             kept left keypoints and of the right keypoints some left one
+//             may match;
+//   stereo    Hamming matching left-right, mutual nearest neighbours among
+//             the pairs that pass the epipolar check on rectified rows
+//             (|v_L - v_R| <= max_epipolar_px, positive disparity); only
+//             stereo matches are kept;
 //   temporal  the tracks seen in the last track_window_frames frames (their
-//             newest left and right descriptors) are matched brute-force to
-//             the new stereo features, in the left and right images
-//             separately; the four-way check accepts a match only when the
-//             left-left AND right-right matches pick the same track;
+//             newest left and right descriptors) are matched to the new
+//             stereo features by mutual nearest neighbours, in the left and
+//             right images separately; the four-way check accepts a match
+//             only when the left-left AND right-right matches pick the same
+//             track;
 //   reject    matches whose landmark reprojects too far from the IMU-predicted
 //             camera are dropped (StereoFrontend::RejectOutliers);
 //   new       stereo features not matched to a track start new tracks.
@@ -22,6 +28,7 @@
 #include <opencv2/features2d.hpp>
 
 #include "vio/frontend/feature_grid.h"
+#include "vio/frontend/hamming_matching.h"
 #include "vio/frontend/stereo_frontend.h"
 
 namespace vio::frontend {
@@ -36,7 +43,8 @@ class BriskFrontend final : public StereoFrontend {
  private:
   struct Detections {
     std::vector<cv::KeyPoint> keypoints;
-    cv::Mat descriptors;  ///< one row per keypoint
+    cv::Mat descriptors;          ///< one row per keypoint
+    std::vector<bool> described;  ///< whether keypoint i's descriptor row is set
   };
   /// Stereo features with their left and right descriptors (row i = feature i).
   struct StereoFeatures {
@@ -44,13 +52,19 @@ class BriskFrontend final : public StereoFrontend {
     cv::Mat left_descriptors, right_descriptors;
   };
 
+  /// The per_cell strongest corners of every grid cell, refined; no descriptors.
   Detections Detect(const cv::Mat& image, int per_cell) const;
-  StereoFeatures MatchStereo(const Detections& left, const Detections& right);
+  /// Descriptors of the keypoints with wanted[i]; BRISK leaves out those too
+  /// near the border (described[i] false).
+  void Describe(const cv::Mat& image, const std::vector<bool>& wanted, Detections* detections) const;
+  /// Per described left keypoint, the right keypoints on its rectified row
+  /// (within max_epipolar_px) with positive disparity.
+  MatchCandidates StereoCandidates(const Detections& left, const Detections& right) const;
+  StereoFeatures MatchStereo(const Detections& left, const Detections& right, const MatchCandidates& candidates);
   void MatchTemporal(StereoFeatures* current) const;
   void Remember(const StereoFeatures& current, const std::vector<LandmarkId>& rejected);
 
   cv::Ptr<cv::BRISK> brisk_;
-  cv::BFMatcher matcher_;
   FeatureGrid grid_;
   std::deque<StereoFeatures> history_;  ///< the last track_window_frames frames, newest first
 };
