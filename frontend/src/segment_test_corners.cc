@@ -36,21 +36,23 @@ constexpr std::array<std::array<int, 2>, kCircle> kCircleOffsets = {{{0, -3},
 
 int SegmentTestScore(const cv::Mat& image, int x, int y) {
   const int centre = image.at<std::uint8_t>(y, x);
-  std::array<int, kCircle> difference{};  // circle pixel - centre
+  // Circle pixel - centre, the first kArc - 1 repeated at the end so every arc
+  // is contiguous in the array.
+  std::array<int, kCircle + kArc - 1> difference{};
   for (int k = 0; k < kCircle; ++k) {
     difference[k] = image.at<std::uint8_t>(y + kCircleOffsets[k][1], x + kCircleOffsets[k][0]) - centre;
   }
+  for (int k = kCircle; k < kCircle + kArc - 1; ++k) difference[k] = difference[k - kCircle];
   // Per arc, the weakest pixel bounds the threshold: t < min(d) for a
-  // brighter arc, t < min(-d) for a darker one.
+  // brighter arc, t < min(-d) = -max(d) for a darker one.
   int best = 0;
   for (int start = 0; start < kCircle; ++start) {
-    int brighter = 255, darker = 255;
-    for (int k = 0; k < kArc; ++k) {
-      const int d = difference[(start + k) % kCircle];
-      brighter = std::min(brighter, d);
-      darker = std::min(darker, -d);
+    int lowest = difference[start], highest = difference[start];
+    for (int k = 1; k < kArc; ++k) {
+      lowest = std::min(lowest, difference[start + k]);
+      highest = std::max(highest, difference[start + k]);
     }
-    best = std::max({best, brighter, darker});
+    best = std::max({best, lowest, -highest});
   }
   return std::max(best - 1, 0);
 }
