@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <tuple>
 #include <unordered_map>
 #include <utility>
@@ -131,6 +132,11 @@ struct GaussNewtonSolver::System {
   std::vector<Eigen::MatrixXd> T;
   Eigen::MatrixXd U;
   Eigen::MatrixXd UUt;
+  /// Contiguous Schur updates waiting to be applied, by (first row, rows);
+  /// ordered, so the order of the updates depends on the layout only.
+  std::map<std::pair<int, int>, std::vector<Eigen::MatrixXd>> pending;
+  Eigen::MatrixXd stacked;
+  Eigen::MatrixXd UL;
 
   System(ceres::Problem* p, GaussNewtonLayout l) : problem(p), layout(std::move(l)) {
     // A lookup from block to column only: no order depends on the addresses.
@@ -245,7 +251,8 @@ struct GaussNewtonSolver::System {
   }
 
   // J_i^T J_j into the upper block triangle of H.
-  void AddDensePair(const Slot& i, const Slot& j, const ConstJacobian& Ji, const ConstJacobian& Jj) {
+  template <typename JacobianI, typename JacobianJ>
+  void AddDensePair(const Slot& i, const Slot& j, const JacobianI& Ji, const JacobianJ& Jj) {
     const Columns& a = dense[i.dense];
     const Columns& c = dense[j.dense];
     if (a.offset <= c.offset) {
@@ -275,30 +282,60 @@ struct GaussNewtonSolver::System {
                                         jacobian_pointers.data())) {
       return false;
     }
-    const Eigen::Map<const Eigen::VectorXd> res(r.data(), residual.rows);
-    const auto jacobian = [&](const Slot& slot) {
-      return ConstJacobian(jacobians.data() + slot.jacobian, residual.rows, slot.tangent);
-    };
+    // A stereo residual (3 rows on 6- and 3-dimensional tangents) takes
+    // fixed-size products; every other shape the dynamic ones.
+    if (residual.rows == 3 && HasTangentsOf3Or6(residual)) {
+      Accumulate(residual, Eigen::Map<const Eigen::Vector3d>(r.data()), [&](const Slot& slot, const auto& use) {
+        const double* data = jacobians.data() + slot.jacobian;
+        if (slot.tangent == 6) {
+          use(Eigen::Map<const Eigen::Matrix<double, 3, 6, Eigen::RowMajor>>(data));
+        } else {
+          use(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(data));
+        }
+      });
+      return true;
+    }
+    Accumulate(residual, Eigen::Map<const Eigen::VectorXd>(r.data(), residual.rows),
+               [&](const Slot& slot, const auto& use) {
+                 use(ConstJacobian(jacobians.data() + slot.jacobian, residual.rows, slot.tangent));
+               });
+    return true;
+  }
+
+  static bool HasTangentsOf3Or6(const Residual& residual) {
+    for (const Slot& slot : residual.slots) {
+      if (slot.variable() && slot.tangent != 3 && slot.tangent != 6) return false;
+    }
+    return true;
+  }
+
+  // One residual's J^T J and J^T r into H and b (dense blocks) and into the
+  // eliminated blocks' H, b and couplings W; with_jacobian(slot, use) calls
+  // use with the slot's Jacobian.
+  template <typename Residuals, typename WithJacobian>
+  void Accumulate(const Residual& residual, const Residuals& res, const WithJacobian& with_jacobian) {
     for (size_t p = 0; p < residual.slots.size(); ++p) {
       const Slot& i = residual.slots[p];
       if (!i.variable()) continue;
-      const ConstJacobian Ji = jacobian(i);
-      if (i.dense >= 0) {
-        b.segment(dense[i.dense].offset, i.tangent).noalias() += Ji.transpose() * res;
-        for (size_t q = p; q < residual.slots.size(); ++q) {
-          const Slot& j = residual.slots[q];
-          if (j.dense >= 0) AddDensePair(i, j, Ji, jacobian(j));
+      with_jacobian(i, [&](const auto& Ji) {
+        if (i.dense >= 0) {
+          b.segment(dense[i.dense].offset, i.tangent).noalias() += Ji.transpose() * res;
+          for (size_t q = p; q < residual.slots.size(); ++q) {
+            const Slot& j = residual.slots[q];
+            if (j.dense >= 0) with_jacobian(j, [&](const auto& Jj) { AddDensePair(i, j, Ji, Jj); });
+          }
+          return;
         }
-        continue;
-      }
-      EliminatedBlock& block = eliminated[i.eliminated];
-      block.b.noalias() += Ji.transpose() * res;
-      block.H.noalias() += Ji.transpose() * Ji;
-      for (const Slot& j : residual.slots) {
-        if (j.dense >= 0) block.W[j.coupling].noalias() += jacobian(j).transpose() * Ji;
-      }
+        EliminatedBlock& block = eliminated[i.eliminated];
+        block.b.noalias() += Ji.transpose() * res;
+        block.H.noalias() += Ji.transpose() * Ji;
+        for (const Slot& j : residual.slots) {
+          if (j.dense >= 0) {
+            with_jacobian(j, [&](const auto& Jj) { block.W[j.coupling].noalias() += Jj.transpose() * Ji; });
+          }
+        }
+      });
     }
-    return true;
   }
 
   // A prior r = r0 + Jp delta with tangent Jacobian Jp T: J^T J = T^T (Jp^T Jp) T
@@ -343,8 +380,9 @@ struct GaussNewtonSolver::System {
   /// Schur complement of the eliminated blocks into (H, b), block by block:
   /// with H_inv = S S^T, U = [W_1; ...; W_m] S, the update is one rank-n
   /// update H -= U U^T over the coupled columns (in place when they are
-  /// contiguous) and b -= U S^T b_e.
+  /// contiguous, grouped by row range: SubtractPendingUpdates) and b -= U S^T b_e.
   void Eliminate() {
+    pending.clear();
     for (EliminatedBlock& block : eliminated) {
       block.H_inv = marginalization::PseudoInverse(block.H);
       const Eigen::LLT<Eigen::MatrixXd> factor(block.H_inv);
@@ -368,7 +406,13 @@ struct GaussNewtonSolver::System {
         U.middleRows(rows, block.W[p].rows()) = block.W[p];
         rows += static_cast<int>(block.W[p].rows());
       }
-      U = U * factor.matrixL();
+      if (U.cols() == 3) {  // a landmark: the 3x3 factor on fixed-size, coefficient by coefficient
+        const Eigen::Matrix3d L = factor.matrixL();
+        UL.noalias() = U.lazyProduct(L);
+        U.swap(UL);
+      } else {
+        U = U * factor.matrixL();
+      }
       const Eigen::VectorXd c = factor.matrixU() * block.b;
       rows = 0;
       for (size_t p = 0; p < block.coupled.size(); ++p) {
@@ -379,7 +423,7 @@ struct GaussNewtonSolver::System {
       if (block.coupled.empty()) continue;
       const int first = dense[block.coupled.front()].offset;
       if (contiguous) {
-        H.block(first, first, rows, rows).selfadjointView<Eigen::Upper>().rankUpdate(U, -1.0);
+        pending[{first, rows}].push_back(U);
         continue;
       }
       UUt.setZero(rows, rows);
@@ -391,6 +435,26 @@ struct GaussNewtonSolver::System {
           H.block(a.offset, c2.offset, a.size, c2.size) -= UUt.block(rp, rq, a.size, c2.size);
         }
       }
+    }
+    SubtractPendingUpdates();
+  }
+
+  // The contiguous updates H -= U U^T grouped by the rows they touch: one
+  // rank update with all the group's columns side by side (landmarks seen by
+  // the same states share the rows) instead of one three-column update each,
+  // which the blocked product handles at a fraction of its speed.
+  void SubtractPendingUpdates() {
+    for (const auto& [rows_of, updates] : pending) {
+      const auto [first, rows] = rows_of;
+      Eigen::Index columns = 0;
+      for (const Eigen::MatrixXd& u : updates) columns += u.cols();
+      stacked.resize(rows, columns);
+      columns = 0;
+      for (const Eigen::MatrixXd& u : updates) {
+        stacked.middleCols(columns, u.cols()) = u;
+        columns += u.cols();
+      }
+      H.block(first, first, rows, rows).selfadjointView<Eigen::Upper>().rankUpdate(stacked, -1.0);
     }
   }
 
