@@ -68,20 +68,18 @@ std::vector<FrameFeature> BriskFrontend::TrackFrame(const cv::Mat& left, const c
 
 BriskFrontend::Detections BriskFrontend::Detect(const cv::Mat& image, int per_cell) const {
   std::vector<cv::KeyPoint> all;
-  const bool single_scale = options().brisk_octaves == 0;
-  if (single_scale) {
-    all = DetectSegmentTestCorners(image, options().brisk_threshold);
-  } else {
+  if (options().brisk_octaves > 0) {
     brisk_->detect(image, all);  // multi-scale: BRISK's own scale-space detector
-  }
-  if (single_scale) {
+  } else {
+    SegmentTestScoreMap scores(image);
+    all = DetectSegmentTestCorners(options().brisk_threshold, &scores);
     // Refined before bucketing: the fitted responses rank the corners of a cell
     // (integer scores tie often, and ties would be broken by raster order).
     for (cv::KeyPoint& k : all) {
       const int x = static_cast<int>(k.pt.x), y = static_cast<int>(k.pt.y);
       if (x >= kRefineMarginPx && y >= kRefineMarginPx && x < image.cols - kRefineMarginPx &&
           y < image.rows - kRefineMarginPx) {
-        RefineCorner(image, &k);
+        RefineCorner(&scores, &k);
       }
     }
   }

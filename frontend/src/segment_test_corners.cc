@@ -57,7 +57,16 @@ int SegmentTestScore(const cv::Mat& image, int x, int y) {
   return std::max(best - 1, 0);
 }
 
-void RefineCorner(const cv::Mat& image, cv::KeyPoint* corner) {
+SegmentTestScoreMap::SegmentTestScoreMap(const cv::Mat& image)
+    : image_(image), scores_(image.size(), CV_32S, cv::Scalar(-1)) {}
+
+int SegmentTestScoreMap::operator()(int x, int y) {
+  int& score = scores_.at<int>(y, x);
+  if (score < 0) score = SegmentTestScore(image_, x, y);
+  return score;
+}
+
+void RefineCorner(SegmentTestScoreMap* scores, cv::KeyPoint* corner) {
   const int x = static_cast<int>(corner->pt.x), y = static_cast<int>(corner->pt.y);
   // Least-squares fit of s = a + b dx + c dy + e dx dy + d (dx^2 - 2/3) +
   // f (dy^2 - 2/3) to the 9 scores: on the 3x3 grid these regressors are
@@ -65,7 +74,7 @@ void RefineCorner(const cv::Mat& image, cv::KeyPoint* corner) {
   double a = 0.0, b = 0.0, c = 0.0, d = 0.0, e = 0.0, f = 0.0;
   for (int dy = -1; dy <= 1; ++dy) {
     for (int dx = -1; dx <= 1; ++dx) {
-      const double s = SegmentTestScore(image, x + dx, y + dy);
+      const double s = (*scores)(x + dx, y + dy);
       a += s / 9.0;
       b += dx * s / 6.0;
       c += dy * s / 6.0;
@@ -84,22 +93,21 @@ void RefineCorner(const cv::Mat& image, cv::KeyPoint* corner) {
       static_cast<float>(a + b * ox + c * oy + e * ox * oy + d * (ox * ox - 2.0 / 3.0) + f * (oy * oy - 2.0 / 3.0));
 }
 
-std::vector<cv::KeyPoint> DetectSegmentTestCorners(const cv::Mat& image, int threshold) {
+std::vector<cv::KeyPoint> DetectSegmentTestCorners(int threshold, SegmentTestScoreMap* scores) {
   std::vector<cv::KeyPoint> raw;
-  cv::FAST(image, raw, threshold, /*nonmaxSuppression=*/false, cv::FastFeatureDetector::TYPE_9_16);
-  // Without suppression cv::FAST leaves the scores out: they are computed
-  // here, into a map where pixels that are no corner score 0.
-  cv::Mat scores = cv::Mat::zeros(image.size(), CV_32S);
+  cv::FAST(scores->image(), raw, threshold, /*nonmaxSuppression=*/false, cv::FastFeatureDetector::TYPE_9_16);
+  // Without suppression cv::FAST leaves the scores out: the raw corners are
+  // scored first, so that during the suppression the known scores are
+  // exactly the corners' (a pixel that is no corner counts as 0).
   for (cv::KeyPoint& c : raw) {
-    const int x = static_cast<int>(c.pt.x), y = static_cast<int>(c.pt.y);
-    scores.at<int>(y, x) = SegmentTestScore(image, x, y);
-    c.response = static_cast<float>(scores.at<int>(y, x));
+    c.response = static_cast<float>((*scores)(static_cast<int>(c.pt.x), static_cast<int>(c.pt.y)));
   }
+  auto corner_score = [&](int x, int y) { return scores->Known(x, y) ? (*scores)(x, y) : 0; };
   auto is_local_maximum = [&](int x, int y) {
-    const int s = scores.at<int>(y, x);
+    const int s = corner_score(x, y);
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
-        if (scores.at<int>(y + dy, x + dx) > s) return false;
+        if (corner_score(x + dx, y + dy) > s) return false;
       }
     }
     return true;

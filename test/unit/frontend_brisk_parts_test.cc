@@ -59,6 +59,16 @@ TEST(SegmentTestScore, ThresholdSelectsExactlyTheCornersFastFinds) {
   }
 }
 
+TEST(SegmentTestScoreMap, ComputesEachPixelOnceAndAsTheFunctionDoes) {
+  const cv::Mat image = TexturedImage(6);
+  SegmentTestScoreMap scores(image);
+  EXPECT_FALSE(scores.Known(50, 40));
+  EXPECT_EQ(scores(50, 40), SegmentTestScore(image, 50, 40));
+  EXPECT_TRUE(scores.Known(50, 40));
+  EXPECT_EQ(scores(50, 40), SegmentTestScore(image, 50, 40));
+  EXPECT_FALSE(scores.Known(51, 40));
+}
+
 TEST(SegmentTestScore, FlatImageScoresZero) {
   const cv::Mat flat(20, 20, CV_8UC1, cv::Scalar(100));
   EXPECT_EQ(SegmentTestScore(flat, 10, 10), 0);
@@ -68,7 +78,8 @@ TEST(RefineCorner, SymmetricNeighbourhoodStaysOnThePixel) {
   cv::Mat image(21, 21, CV_8UC1, cv::Scalar(40));
   cv::circle(image, cv::Point(10, 10), 1, cv::Scalar(220), cv::FILLED);  // a dot symmetric about (10, 10)
   cv::KeyPoint corner(cv::Point2f(10.0f, 10.0f), kBriskKeypointSizePx, -1.0f, 0.0f);
-  RefineCorner(image, &corner);
+  SegmentTestScoreMap scores(image);
+  RefineCorner(&scores, &corner);
   EXPECT_EQ(corner.pt, cv::Point2f(10.0f, 10.0f));
   EXPECT_GE(corner.response, static_cast<float>(SegmentTestScore(image, 10, 10)) - 1e-3f);
 }
@@ -79,11 +90,12 @@ TEST(RefineCorner, SymmetricNeighbourhoodStaysOnThePixel) {
 TEST(RefineCorner, MovesCornersByAtMostOnePixelToTheFittedMaximum) {
   const cv::Mat image = TexturedImage(4);
   int moved = 0, corners = 0;
-  for (cv::KeyPoint c : DetectSegmentTestCorners(image, 10)) {
+  SegmentTestScoreMap scores(image);
+  for (cv::KeyPoint c : DetectSegmentTestCorners(10, &scores)) {
     const int x = static_cast<int>(c.pt.x), y = static_cast<int>(c.pt.y);
     if (x < 4 || y < 4 || x >= image.cols - 4 || y >= image.rows - 4) continue;
     ++corners;
-    RefineCorner(image, &c);
+    RefineCorner(&scores, &c);
     EXPECT_LE(std::abs(c.pt.x - static_cast<float>(x)), 1.0f);
     EXPECT_LE(std::abs(c.pt.y - static_cast<float>(y)), 1.0f);
     if (c.pt == cv::Point2f(static_cast<float>(x), static_cast<float>(y))) continue;
@@ -99,7 +111,8 @@ TEST(DetectSegmentTestCorners, KeepsTheLocalMaximaOfTheScoreWithTheirPlateaus) {
   const cv::Mat image = TexturedImage(5);
   std::vector<cv::KeyPoint> fast;
   cv::FAST(image, fast, 15, /*nonmaxSuppression=*/true, cv::FastFeatureDetector::TYPE_9_16);
-  const std::vector<cv::KeyPoint> corners = DetectSegmentTestCorners(image, 15);
+  SegmentTestScoreMap scores(image);
+  const std::vector<cv::KeyPoint> corners = DetectSegmentTestCorners(15, &scores);
   std::set<std::pair<int, int>> kept;
   for (const cv::KeyPoint& c : corners) {
     const int x = static_cast<int>(c.pt.x), y = static_cast<int>(c.pt.y);

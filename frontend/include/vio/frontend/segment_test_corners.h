@@ -21,19 +21,37 @@ inline constexpr float kBriskKeypointSizePx = 12.0f;
 /// Requires 3 <= x < cols - 3 and 3 <= y < rows - 3.
 int SegmentTestScore(const cv::Mat& image, int x, int y);
 
+/// SegmentTestScore of one image's pixels, each computed at most once (the
+/// detector scores every raw corner, the refinement their neighbours).
+class SegmentTestScoreMap {
+ public:
+  /// Keeps a reference: `image` must outlive the map.
+  explicit SegmentTestScoreMap(const cv::Mat& image);
+  /// The score of pixel (x, y), same requirements as SegmentTestScore.
+  int operator()(int x, int y);
+  /// Whether (x, y)'s score has been computed.
+  bool Known(int x, int y) const { return scores_.at<int>(y, x) >= 0; }
+  const cv::Mat& image() const { return image_; }
+
+ private:
+  const cv::Mat& image_;
+  cv::Mat scores_;  ///< CV_32S, -1 where not computed yet
+};
+
 /// Refines a corner found at an integer pixel as BRISK refines its
 /// single-scale keypoints: the quadratic fitted (least squares) to the scores
 /// of its 3x3 neighbourhood gives the position (its maximum, at most one pixel
 /// away) and the response (the value there). A corner whose fitted quadratic
 /// has no maximum stays as it is. Requires 4 <= x < cols - 4 and
 /// 4 <= y < rows - 4 for the corner's pixel (x, y).
-void RefineCorner(const cv::Mat& image, cv::KeyPoint* corner);
+void RefineCorner(SegmentTestScoreMap* scores, cv::KeyPoint* corner);
 
-/// FAST 9-16 corners at `threshold` that no 8-neighbour outscores (equal
-/// neighbours are both kept, as BRISK's suppression keeps plateaus; cv::FAST's
-/// own suppression drops both, which halves how many corners survive from
-/// frame to frame), each a cv::KeyPoint at its integer pixel with the
-/// segment-test score as response and size kBriskKeypointSizePx.
-std::vector<cv::KeyPoint> DetectSegmentTestCorners(const cv::Mat& image, int threshold);
+/// FAST 9-16 corners at `threshold` that no 8-neighbour corner outscores
+/// (equal neighbours are both kept, as BRISK's suppression keeps plateaus;
+/// cv::FAST's own suppression drops both, which halves how many corners
+/// survive from frame to frame), each a cv::KeyPoint at its integer pixel with
+/// the segment-test score as response and size kBriskKeypointSizePx. Scores
+/// every raw corner into `scores`, which must hold no other scores yet.
+std::vector<cv::KeyPoint> DetectSegmentTestCorners(int threshold, SegmentTestScoreMap* scores);
 
 }  // namespace vio::frontend
