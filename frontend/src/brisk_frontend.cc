@@ -134,7 +134,8 @@ MatchCandidates BriskFrontend::StereoCandidates(const Detections& left, const De
     auto it = std::lower_bound(rows.begin(), rows.end(), uv->y() - band,
                                [](const Rectified& r, double v) { return r.v < v; });
     for (; it != rows.end() && it->v <= uv->y() + band; ++it) {
-      if (uv->x() - it->u > 0.0) candidates[i].push_back(it->index);
+      const double disparity = uv->x() - it->u;
+      if (disparity > 0.0 && disparity <= options().brisk_max_disparity_px) candidates[i].push_back(it->index);
     }
     std::sort(candidates[i].begin(), candidates[i].end());
   }

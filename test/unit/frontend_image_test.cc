@@ -164,6 +164,33 @@ TEST_P(ImageFrontendTest, DrawsBothImagesSideBySide) {
 INSTANTIATE_TEST_SUITE_P(BothFrontEnds, ImageFrontendTest, ::testing::Values("brisk", "klt"),
                          [](const auto& info) { return info.param; });
 
+// BRISK matches in stereo only up to brisk_max_disparity_px: the plane's
+// disparity (about 25 px) is found under the default and under a cap just
+// above it; under a cap below it every match is gone but the few false ones
+// the cap allows.
+TEST(BriskFrontend, StereoMatchesStopAtTheLargestDisparity) {
+  const StereoRectifier rectifier(Pinhole(0.0), Pinhole(kBaselineM));
+  const int disparity = static_cast<int>(std::lround(kFocalPx * kBaselineM / kDepthM));
+  const Pair pair = View(Texture(7), 0, disparity);
+  auto stereo = [&](double cap_px) {
+    FrontendOptions options;
+    options.frontend = "brisk";
+    options.brisk_max_disparity_px = cap_px;
+    const std::vector<StereoObservation> observations =
+        MakeStereoFrontend(options, rectifier)->Process(1, pair.left, pair.right, FramePrior{}).observations;
+    for (const StereoObservation& obs : observations) EXPECT_LE(obs.z_px.x() - obs.z_px.y(), cap_px);
+    return observations.size();
+  };
+  const size_t all = stereo(FrontendOptions().brisk_max_disparity_px);
+  ASSERT_GE(all, 100u);
+  EXPECT_EQ(stereo(disparity + 3.0), all);
+  EXPECT_LE(stereo(disparity - 3.0), all / 50);
+  FrontendOptions bad;
+  bad.frontend = "brisk";
+  bad.brisk_max_disparity_px = 0.0;
+  EXPECT_THROW(MakeStereoFrontend(bad, rectifier), std::invalid_argument);
+}
+
 TEST(MakeStereoFrontend, RejectsTheFeaturesFrontEnd) {
   FrontendOptions options;
   options.frontend = "features";

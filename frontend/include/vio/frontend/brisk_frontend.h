@@ -11,7 +11,8 @@
 //             may match;
 //   stereo    Hamming matching left-right, mutual nearest neighbours among
 //             the pairs that pass the epipolar check on rectified rows
-//             (|v_L - v_R| <= max_epipolar_px, positive disparity); only
+//             (|v_L - v_R| <= max_epipolar_px, disparity in
+//             (0, brisk_max_disparity_px]); only
 //             stereo matches are kept;
 //   temporal  the tracks seen in the last track_window_frames frames (their
 //             newest left and right descriptors) are matched to the new
@@ -58,7 +59,7 @@ class BriskFrontend final : public StereoFrontend {
   /// near the border (described[i] false).
   void Describe(const cv::Mat& image, const std::vector<bool>& wanted, Detections* detections) const;
   /// Per described left keypoint, the right keypoints on its rectified row
-  /// (within max_epipolar_px) with positive disparity.
+  /// (within max_epipolar_px) with a disparity in (0, brisk_max_disparity_px].
   MatchCandidates StereoCandidates(const Detections& left, const Detections& right) const;
   StereoFeatures MatchStereo(const Detections& left, const Detections& right, const MatchCandidates& candidates);
   void MatchTemporal(StereoFeatures* current) const;

@@ -24,6 +24,8 @@ struct FrontendOptions {
   int brisk_octaves = 0;
   /// BRISK: strongest keypoints kept per grid cell and image [count].
   int brisk_per_cell = 5;
+  /// BRISK: largest disparity of a stereo match, the right keypoints further left are no candidates [px].
+  double brisk_max_disparity_px = 128.0;
   /// BRISK: largest Hamming distance of an accepted descriptor match [bits of 512].
   int max_hamming_bits = 90;
   /// BRISK: tracks seen in the last this many frames are matched to the new one [frames].
@@ -63,6 +65,7 @@ struct FrontendOptions {
     v("brisk_threshold", brisk_threshold, "BRISK AGAST detection threshold [grey levels]", Between(0, 255));
     v("brisk_octaves", brisk_octaves, "BRISK scale-space octaves [count]", Between(0, 8));
     v("brisk_per_cell", brisk_per_cell, "BRISK keypoints kept per grid cell and image [count]", AtLeast(1));
+    v("brisk_max_disparity_px", brisk_max_disparity_px, "BRISK largest disparity of a stereo match [px]", Positive());
     v("max_hamming_bits", max_hamming_bits, "largest Hamming distance of a BRISK match [bits of 512]", Between(0, 512));
     v("track_window_frames", track_window_frames,
       "BRISK matches the new frame to tracks seen in this many previous frames [frames]", AtLeast(1));
