@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <tuple>
 #include <unordered_map>
 #include <utility>
@@ -62,6 +61,14 @@ struct EliminatedBlock {
   Eigen::VectorXd b;               ///< J_e^T r
   std::vector<Eigen::MatrixXd> W;  ///< J_d^T J_e per coupled dense block
   Eigen::MatrixXd H_inv;           ///< (pseudo-)inverse of H
+  Eigen::MatrixXd U;               ///< its Schur update is -U U^T on contiguous coupled columns
+};
+
+/// A Schur update -U U^T waiting to be applied to rows [first, first + rows).
+struct PendingUpdate {
+  int first = 0;
+  int rows = 0;
+  int block = 0;  ///< the eliminated block holding U
 };
 
 void ApplyStep(ceres::Problem* problem, const std::vector<double*>& blocks, const Eigen::VectorXd& dx,
@@ -132,9 +139,8 @@ struct GaussNewtonSolver::System {
   std::vector<Eigen::MatrixXd> T;
   Eigen::MatrixXd U;
   Eigen::MatrixXd UUt;
-  /// Contiguous Schur updates waiting to be applied, by (first row, rows);
-  /// ordered, so the order of the updates depends on the layout only.
-  std::map<std::pair<int, int>, std::vector<Eigen::MatrixXd>> pending;
+  /// Contiguous Schur updates waiting to be applied (SubtractPendingUpdates).
+  std::vector<PendingUpdate> pending;
   Eigen::MatrixXd stacked;
   Eigen::MatrixXd UL;
 
@@ -383,7 +389,8 @@ struct GaussNewtonSolver::System {
   /// contiguous, grouped by row range: SubtractPendingUpdates) and b -= U S^T b_e.
   void Eliminate() {
     pending.clear();
-    for (EliminatedBlock& block : eliminated) {
+    for (size_t k = 0; k < eliminated.size(); ++k) {
+      EliminatedBlock& block = eliminated[k];
       block.H_inv = marginalization::PseudoInverse(block.H);
       const Eigen::LLT<Eigen::MatrixXd> factor(block.H_inv);
       if (factor.info() != Eigen::Success) {  // H_inv singular (rank-truncated): no square root
@@ -423,7 +430,8 @@ struct GaussNewtonSolver::System {
       if (block.coupled.empty()) continue;
       const int first = dense[block.coupled.front()].offset;
       if (contiguous) {
-        pending[{first, rows}].push_back(U);
+        block.U = U;
+        pending.push_back({first, rows, static_cast<int>(k)});
         continue;
       }
       UUt.setZero(rows, rows);
@@ -444,17 +452,26 @@ struct GaussNewtonSolver::System {
   // the same states share the rows) instead of one three-column update each,
   // which the blocked product handles at a fraction of its speed.
   void SubtractPendingUpdates() {
-    for (const auto& [rows_of, updates] : pending) {
-      const auto [first, rows] = rows_of;
+    // Grouped by row range; within a group in block order, so the order of
+    // the updates depends on the layout only.
+    std::stable_sort(pending.begin(), pending.end(), [](const PendingUpdate& a, const PendingUpdate& b) {
+      return std::tie(a.first, a.rows) < std::tie(b.first, b.rows);
+    });
+    for (size_t begin = 0, end = 0; begin < pending.size(); begin = end) {
+      const PendingUpdate& group = pending[begin];
       Eigen::Index columns = 0;
-      for (const Eigen::MatrixXd& u : updates) columns += u.cols();
-      stacked.resize(rows, columns);
+      for (end = begin; end < pending.size() && pending[end].first == group.first && pending[end].rows == group.rows;
+           ++end) {
+        columns += eliminated[pending[end].block].U.cols();
+      }
+      stacked.resize(group.rows, columns);
       columns = 0;
-      for (const Eigen::MatrixXd& u : updates) {
+      for (size_t k = begin; k < end; ++k) {
+        const Eigen::MatrixXd& u = eliminated[pending[k].block].U;
         stacked.middleCols(columns, u.cols()) = u;
         columns += u.cols();
       }
-      H.block(first, first, rows, rows).selfadjointView<Eigen::Upper>().rankUpdate(stacked, -1.0);
+      H.block(group.first, group.first, group.rows, group.rows).selfadjointView<Eigen::Upper>().rankUpdate(stacked, -1.0);
     }
   }
 

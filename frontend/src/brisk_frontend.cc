@@ -13,9 +13,6 @@ namespace {
 
 /// The right image keeps this many times brisk_per_cell keypoints per cell.
 constexpr int kRightCellFactor = 3;
-/// Sub-pixel refinement reads the scores of the 3x3 neighbourhood, whose
-/// circles reach this far [px].
-constexpr int kRefineMarginPx = 4;
 
 Eigen::Vector2d ToEigen(const cv::Point2f& p) { return Eigen::Vector2d(p.x, p.y); }
 
@@ -75,13 +72,7 @@ BriskFrontend::Detections BriskFrontend::Detect(const cv::Mat& image, int per_ce
     all = DetectSegmentTestCorners(options().brisk_threshold, &scores);
     // Refined before bucketing: the fitted responses rank the corners of a cell
     // (integer scores tie often, and ties would be broken by raster order).
-    for (cv::KeyPoint& k : all) {
-      const int x = static_cast<int>(k.pt.x), y = static_cast<int>(k.pt.y);
-      if (x >= kRefineMarginPx && y >= kRefineMarginPx && x < image.cols - kRefineMarginPx &&
-          y < image.rows - kRefineMarginPx) {
-        RefineCorner(&scores, &k);
-      }
-    }
+    for (cv::KeyPoint& k : all) RefineCorner(&scores, &k);
   }
   Detections out;
   for (int i : grid_.Bucket(all, per_cell)) out.keypoints.push_back(all[static_cast<size_t>(i)]);

@@ -11,6 +11,8 @@ namespace {
 
 constexpr int kCircle = 16;  ///< pixels on the circle
 constexpr int kArc = 9;      ///< contiguous pixels the test needs
+/// The 3x3 neighbourhood's circles reach this far from the corner [px].
+constexpr int kRefineMarginPx = 4;
 /// The refined maximum stays within the 3x3 neighbourhood it is fitted on [px].
 constexpr double kMaxRefinementPx = 1.0;
 
@@ -68,6 +70,11 @@ int SegmentTestScoreMap::operator()(int x, int y) {
 
 void RefineCorner(SegmentTestScoreMap* scores, cv::KeyPoint* corner) {
   const int x = static_cast<int>(corner->pt.x), y = static_cast<int>(corner->pt.y);
+  const cv::Mat& image = scores->image();
+  if (x < kRefineMarginPx || y < kRefineMarginPx || x >= image.cols - kRefineMarginPx ||
+      y >= image.rows - kRefineMarginPx) {
+    return;  // the neighbours' circles would leave the image
+  }
   // Least-squares fit of s = a + b dx + c dy + e dx dy + d (dx^2 - 2/3) +
   // f (dy^2 - 2/3) to the 9 scores: on the 3x3 grid these regressors are
   // orthogonal, so each coefficient is one normalized sum.

@@ -87,15 +87,21 @@ TEST(RefineCorner, SymmetricNeighbourhoodStaysOnThePixel) {
 // The position moves at most one pixel and the response is the fitted
 // quadratic's maximum: at least the fit's value at the pixel, which is close
 // to the pixel's own score.
-TEST(RefineCorner, MovesCornersByAtMostOnePixelToTheFittedMaximum) {
+TEST(RefineCorner, MovesCornersByAtMostOnePixelToTheFittedMaximumAndLeavesTheBorderAlone) {
   const cv::Mat image = TexturedImage(4);
-  int moved = 0, corners = 0;
+  int moved = 0, corners = 0, border = 0;
   SegmentTestScoreMap scores(image);
   for (cv::KeyPoint c : DetectSegmentTestCorners(10, &scores)) {
     const int x = static_cast<int>(c.pt.x), y = static_cast<int>(c.pt.y);
-    if (x < 4 || y < 4 || x >= image.cols - 4 || y >= image.rows - 4) continue;
-    ++corners;
+    const cv::KeyPoint before = c;
     RefineCorner(&scores, &c);
+    if (x < 4 || y < 4 || x >= image.cols - 4 || y >= image.rows - 4) {  // too near the border: unrefined
+      EXPECT_EQ(c.pt, before.pt);
+      EXPECT_EQ(c.response, before.response);
+      ++border;
+      continue;
+    }
+    ++corners;
     EXPECT_LE(std::abs(c.pt.x - static_cast<float>(x)), 1.0f);
     EXPECT_LE(std::abs(c.pt.y - static_cast<float>(y)), 1.0f);
     if (c.pt == cv::Point2f(static_cast<float>(x), static_cast<float>(y))) continue;
@@ -103,6 +109,7 @@ TEST(RefineCorner, MovesCornersByAtMostOnePixelToTheFittedMaximum) {
     EXPECT_NEAR(c.response, SegmentTestScore(image, x, y), 0.5 * SegmentTestScore(image, x, y)) << c.pt;
   }
   EXPECT_GT(moved, corners / 2);
+  EXPECT_GT(border, 0);
 }
 
 // Every corner cv::FAST keeps after its suppression is kept, and every kept

@@ -42,8 +42,8 @@ class SegmentTestScoreMap {
 /// single-scale keypoints: the quadratic fitted (least squares) to the scores
 /// of its 3x3 neighbourhood gives the position (its maximum, at most one pixel
 /// away) and the response (the value there). A corner whose fitted quadratic
-/// has no maximum stays as it is. Requires 4 <= x < cols - 4 and
-/// 4 <= y < rows - 4 for the corner's pixel (x, y).
+/// has no maximum stays as it is, and so does a corner within 4 px of the
+/// border (its neighbours' circles would leave the image).
 void RefineCorner(SegmentTestScoreMap* scores, cv::KeyPoint* corner);
 
 /// FAST 9-16 corners at `threshold` that no 8-neighbour corner outscores
