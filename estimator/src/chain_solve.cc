@@ -49,20 +49,38 @@ void ChainSolver::ForwardSolve(Eigen::Ref<Eigen::MatrixXd> r) const {
   }
 }
 
-// z <- L^-T z.
-void ChainSolver::BackwardSolve(Eigen::Ref<Eigen::VectorXd> z) const {
+// z <- L^-T z, z with one row block per chain block.
+void ChainSolver::BackwardSolve(Eigen::Ref<Eigen::MatrixXd> z) const {
   const int m = static_cast<int>(diagonal_.size());
   for (int i = m - 1; i >= 0; --i) {
     const int size = static_cast<int>(diagonal_[i].rows());
     for (int k = i + 1; k < std::min(m, i + bandwidth_ + 1); ++k) {
-      z.segment(rows_[i], size).noalias() -= L(k, i).transpose() * z.segment(rows_[k], L(k, i).rows());
+      z.middleRows(rows_[i], size).noalias() -= L(k, i).transpose() * z.middleRows(rows_[k], L(k, i).rows());
     }
-    diagonal_[i].matrixU().solveInPlace(z.segment(rows_[i], size));
+    diagonal_[i].matrixU().solveInPlace(z.middleRows(rows_[i], size));
   }
 }
 
-// With H_cc = L L^T, X = L^-1 H_cr and y = L^-1 b_c: the rest solves
-// (H_rr - X^T X) dx_r = -(b_r - X^T y), then L^T dx_c = -(y + X dx_r).
+// S = H_rr - H_rc Z with Z = H_cc^-1 H_cr, row block by chain block: chain
+// block i touches only the rest columns its rows of H_cr are non-zero in (the
+// IMU factors: two poses; a prior: the poses it spans), so this costs
+// nnz(H_cr) x rest instead of the chain x rest^2 of forming (L^-1 H_cr)^T (L^-1 H_cr).
+void ChainSolver::SubtractCoupling() {
+  for (size_t i = 0; i < rows_.size(); ++i) {
+    const int size = static_cast<int>(diagonal_[i].rows());
+    coupled_.clear();
+    for (int j = 0; j < static_cast<int>(rest_.size()); ++j) {
+      if (!B_.block(rows_[i], j, size, 1).isZero(0.0)) coupled_.push_back(j);
+    }
+    if (coupled_.empty()) continue;
+    B_i_ = B_(Eigen::seqN(rows_[i], size), coupled_);
+    update_.noalias() = B_i_.transpose() * Z_.middleRows(rows_[i], size);
+    S_(coupled_, Eigen::all) -= update_;
+  }
+}
+
+// With H_cc = L L^T, Z = H_cc^-1 H_cr and w = H_cc^-1 b_c: the rest solves
+// (H_rr - H_rc Z) dx_r = -(b_r - H_rc w), then dx_c = -(w + Z dx_r).
 bool ChainSolver::Solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, const std::vector<ChainBlock>& chain,
                         int bandwidth, Eigen::VectorXd* dx) {
   const int n = static_cast<int>(H.rows());
@@ -84,30 +102,30 @@ bool ChainSolver::Solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, cons
   if (!FactorChain(H, chain)) return false;
   const int nc = static_cast<int>(chain_columns.size());
   const int nr = static_cast<int>(rest_.size());
-  X_.resize(nc, nr);
+  B_.resize(nc, nr);
   S_.resize(nr, nr);
   for (int j = 0; j < nr; ++j) {
-    for (int i = 0; i < nc; ++i) X_(i, j) = UpperEntry(H, chain_columns[i], rest_[j]);
+    for (int i = 0; i < nc; ++i) B_(i, j) = UpperEntry(H, chain_columns[i], rest_[j]);
     for (int i = 0; i <= j; ++i) S_(i, j) = H(rest_[i], rest_[j]);
   }
-  y_ = b(chain_columns);
-  ForwardSolve(X_);
-  ForwardSolve(y_);
-  S_.selfadjointView<Eigen::Upper>().rankUpdate(X_.transpose(), -1.0);
+  Z_ = B_;
+  ForwardSolve(Z_);
+  BackwardSolve(Z_);
+  w_ = b(chain_columns);
+  ForwardSolve(w_);
+  BackwardSolve(w_);
+  SubtractCoupling();
   dx_rest_.resize(nr);
   if (nr > 0) {
     const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Upper> llt(S_);  // in place
     if (llt.info() != Eigen::Success) return false;
-    dx_rest_.noalias() = X_.transpose() * y_;
+    dx_rest_.noalias() = B_.transpose() * w_;
     dx_rest_ -= b(rest_);
     llt.solveInPlace(dx_rest_);
   }
-  z_ = y_;
-  z_.noalias() += X_ * dx_rest_;
-  z_ = -z_;
-  BackwardSolve(z_);
+  w_.noalias() += Z_ * dx_rest_;
   dx->resize(n);
-  (*dx)(chain_columns) = z_;
+  (*dx)(chain_columns) = -w_;
   (*dx)(rest_) = dx_rest_;
   return dx->allFinite();
 }

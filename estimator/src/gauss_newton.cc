@@ -135,8 +135,8 @@ struct GaussNewtonSolver::System {
   std::vector<double> r;
   std::vector<double> jacobians;
   std::vector<double*> jacobian_pointers;
-  Eigen::VectorXd delta;
-  std::vector<Eigen::MatrixXd> T;
+  Eigen::MatrixXd prior_H;
+  Eigen::VectorXd prior_g;
   Eigen::MatrixXd U;
   Eigen::MatrixXd UUt;
   /// Contiguous Schur updates waiting to be applied (SubtractPendingUpdates).
@@ -269,7 +269,8 @@ struct GaussNewtonSolver::System {
   }
 
   // A product for blocks (i, j) into the upper block triangle of H.
-  void AddDenseProduct(const Slot& i, const Slot& j, const Eigen::MatrixXd& product) {
+  template <typename Product>
+  void AddDenseProduct(const Slot& i, const Slot& j, const Product& product) {
     const Columns& a = dense[i.dense];
     const Columns& c = dense[j.dense];
     if (a.offset <= c.offset) {
@@ -344,29 +345,20 @@ struct GaussNewtonSolver::System {
     }
   }
 
-  // A prior r = r0 + Jp delta with tangent Jacobian Jp T: J^T J = T^T (Jp^T Jp) T
-  // and J^T r = T^T (Jp^T r0 + Jp^T Jp delta), from its precomputed information.
+  // A prior r = r0 + Jp delta, assembled from its information (see
+  // MarginalizationPrior::TangentNormalEquations) without forming Jp T.
   bool AddPrior(const Residual& residual, double* cost) {
     const marginalization::MarginalizationPrior& prior = *residual.prior;
-    if (!prior.TangentJacobians(residual.values.data(), &delta, &T)) return false;
-    *cost = 0.5 * (prior.residual_at_x0() + prior.sqrt_information() * delta).squaredNorm();
-    const Eigen::VectorXd g = prior.information_vector() + prior.information() * delta;
+    if (!prior.TangentNormalEquations(residual.values.data(), &prior_H, &prior_g, cost)) return false;
     const int n = static_cast<int>(residual.slots.size());
-    std::vector<bool> identity(static_cast<size_t>(n));
-    for (int i = 0; i < n; ++i) identity[i] = T[i].isIdentity(0.0);
-    const auto tangent_map = [&](int i, const auto& m) -> Eigen::MatrixXd {
-      return identity[i] ? Eigen::MatrixXd(m) : Eigen::MatrixXd(T[i].transpose() * m);
-    };
     for (int i = 0; i < n; ++i) {
       const Slot& si = residual.slots[i];
       if (si.dense < 0) continue;
-      b.segment(dense[si.dense].offset, si.tangent) += tangent_map(i, g.segment(prior.tangent_offset(i), si.tangent));
+      b.segment(dense[si.dense].offset, si.tangent) += prior_g.segment(prior.tangent_offset(i), si.tangent);
       for (int j = i; j < n; ++j) {
         const Slot& sj = residual.slots[j];
         if (sj.dense < 0) continue;
-        const Eigen::MatrixXd left = tangent_map(
-            i, prior.information().block(prior.tangent_offset(i), prior.tangent_offset(j), si.tangent, sj.tangent));
-        AddDenseProduct(si, sj, identity[j] ? left : Eigen::MatrixXd(left * T[j]));
+        AddDenseProduct(si, sj, prior_H.block(prior.tangent_offset(i), prior.tangent_offset(j), si.tangent, sj.tangent));
       }
     }
     return true;

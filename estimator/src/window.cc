@@ -11,6 +11,7 @@
 #include "vio/estimator/pose_prior_factor.h"
 #include "vio/estimator/speed_bias_prior_factor.h"
 #include "vio/estimator/stereo_factor.h"
+#include "vio/marginalization/marginalization_prior.h"
 #include "vio/marginalization/marginalizer.h"
 
 namespace vio {
@@ -21,15 +22,22 @@ constexpr double kNoAccelThreshold = std::numeric_limits<double>::infinity();
 // current point.
 bool EvaluatesFinitely(const ceres::Problem& problem, ceres::ResidualBlockId id) {
   const ceres::CostFunction* f = problem.GetCostFunctionForResidualBlock(id);
+  // A prior's Jacobian (its finite Jp times the manifolds' finite tangent
+  // maps) is finite wherever its residual is: its residual alone is checked,
+  // which spares forming its dense n x n Jacobian.
+  const bool residual_only = dynamic_cast<const marginalization::MarginalizationPrior*>(f) != nullptr;
   std::vector<double> residuals(static_cast<size_t>(f->num_residuals()));
   std::vector<std::vector<double>> jacobian_storage;
   std::vector<double*> jacobians;
   for (const int size : f->parameter_block_sizes()) {
+    if (residual_only) break;
     jacobian_storage.emplace_back(static_cast<size_t>(size * f->num_residuals()));
     jacobians.push_back(jacobian_storage.back().data());
   }
   double cost = 0.0;
-  if (!problem.EvaluateResidualBlock(id, true, &cost, residuals.data(), jacobians.data())) return false;
+  if (!problem.EvaluateResidualBlock(id, true, &cost, residuals.data(), residual_only ? nullptr : jacobians.data())) {
+    return false;
+  }
   const auto finite = [](const std::vector<double>& v) {
     return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
   };

@@ -1,6 +1,9 @@
 #include "vio/marginalization/linear_algebra.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -12,8 +15,10 @@
 namespace vio::marginalization {
 namespace {
 
-// Largest relative error ||Jp^T Jp - H||_F / ||H||_F the pivoted LDLT square root may leave.
+// Largest relative error ||Jp^T Jp - H||_F / ||H||_F the Cholesky square roots may leave.
 constexpr double kReconstructionTolerance = 1e-13;
+// Probe vectors that estimate that error.
+constexpr int kProbes = 4;
 
 /// The eigen-pairs of a symmetric PSD matrix whose eigenvalue survives the
 /// threshold: H ~= eigenvectors * diag(eigenvalues) * eigenvectors^T.
@@ -119,45 +124,138 @@ void EliminateBlock(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, int offs
   marginal->b(coupled_rows) -= H_KM_H_MM_inv * b.segment(offset, dim);
 }
 
+/// Jp^T Jp, formed once (n^2 rank flops).
+Eigen::MatrixXd GramOf(const Eigen::MatrixXd& Jp) {
+  Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(Jp.cols(), Jp.cols());
+  gram.selfadjointView<Eigen::Lower>().rankUpdate(Jp.transpose());
+  gram.triangularView<Eigen::StrictlyUpper>() = gram.transpose();
+  return gram;
+}
+
 SqrtInformation SqrtByEigen(const Eigen::MatrixXd& H, const Eigen::VectorXd& b,
                             const RankThreshold& threshold) {
   const SignificantEigenpairs eig = DecomposeSignificant(H, threshold);
   const Eigen::MatrixXd V_transpose = eig.eigenvectors.transpose();
   const Eigen::VectorXd sqrt_lambda = eig.eigenvalues.cwiseSqrt();
-  return {sqrt_lambda.asDiagonal() * V_transpose,
-          sqrt_lambda.cwiseInverse().asDiagonal() * (V_transpose * b)};
+  SqrtInformation sqrt{sqrt_lambda.asDiagonal() * V_transpose,
+                       sqrt_lambda.cwiseInverse().asDiagonal() * (V_transpose * b), Eigen::MatrixXd()};
+  sqrt.information = GramOf(sqrt.sqrt_information);
+  return sqrt;
 }
 
-SqrtInformation SqrtByPivotedLdlt(const Eigen::MatrixXd& H, const Eigen::VectorXd& b,
-                                  const RankThreshold& threshold) {
-  const int n = static_cast<int>(H.rows());
-  if (n == 0) {
-    return {Eigen::MatrixXd(0, 0), Eigen::VectorXd(0)};
+/// Fixed +-1 probe vectors (n x kProbes), the same for every call: for any E,
+/// the mean of |E v|^2 over such v is ||E||_F^2.
+Eigen::MatrixXd ProbeVectors(Eigen::Index n) {
+  Eigen::MatrixXd V(n, kProbes);
+  std::uint64_t state = 0x9E3779B97F4A7C15ULL;
+  for (Eigen::Index k = 0; k < V.size(); ++k) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;  // Knuth's MMIX LCG
+    V.data()[k] = (state >> 63) != 0 ? 1.0 : -1.0;
   }
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(SymmetricPart(H));
-  if (ldlt.info() != Eigen::Success) {  // a zero pivot with a non-zero column: not PSD
-    return SqrtByEigen(H, b, threshold);
-  }
-  const Eigen::VectorXd D = ldlt.vectorD();
-  const double cutoff = EigenvalueCutoff(D.maxCoeff(), threshold);
-  std::vector<int> kept;
-  for (int i = 0; i < n; ++i) {
-    if (D(i) > cutoff) {
-      kept.push_back(i);
+  return V;
+}
+
+/// Whether Jp^T Jp gives H back to kReconstructionTolerance (relative,
+/// Frobenius), estimated on kProbes probe vectors: O(n^2) instead of the n^3
+/// of forming Jp^T Jp. The failure it guards against (amplified round-off
+/// after a round-off pivot) is many orders above the tolerance.
+bool Reproduces(const Eigen::MatrixXd& Jp, const Eigen::MatrixXd& H) {
+  const Eigen::MatrixXd V = ProbeVectors(H.cols());
+  const Eigen::MatrixXd JpV = Jp * V;
+  const Eigen::MatrixXd error = Jp.transpose() * JpV - H * V;
+  return error.norm() <= kReconstructionTolerance * H.norm() * std::sqrt(static_cast<double>(kProbes));
+}
+
+/// Jp = L^T, r0 = L^-1 b from the blocked Cholesky factor H = L L^T when
+/// every pivot L_ii^2 clears the threshold (relative to H's largest diagonal,
+/// the first pivot of the pivoted factorization): then nothing is dropped, and
+/// this square root differs from the pivoted one only by an orthogonal
+/// transform of its rows (the same prior). Empty when H is not that clearly
+/// definite.
+std::optional<SqrtInformation> SqrtByCholesky(const Eigen::MatrixXd& H_symmetric, const Eigen::VectorXd& b,
+                                              const RankThreshold& threshold) {
+  const Eigen::LLT<Eigen::MatrixXd> llt(H_symmetric);
+  if (llt.info() != Eigen::Success) return std::nullopt;
+  const double cutoff = EigenvalueCutoff(H_symmetric.diagonal().maxCoeff(), threshold);
+  if (!(llt.matrixLLT().diagonal().array().square() > cutoff).all()) return std::nullopt;
+  SqrtInformation sqrt{llt.matrixU(), llt.matrixL().solve(b), Eigen::MatrixXd()};
+  if (!Reproduces(sqrt.sqrt_information, H_symmetric)) return std::nullopt;
+  return sqrt;
+}
+
+/// Swaps variables k < j of the symmetric matrix held in A's lower triangle.
+void SymmetricSwap(Eigen::MatrixXd& A, Eigen::Index k, Eigen::Index j) {
+  const Eigen::Index n = A.rows();
+  std::swap(A(k, k), A(j, j));
+  A.row(k).head(k).swap(A.row(j).head(k));
+  A.col(k).tail(n - j - 1).swap(A.col(j).tail(n - j - 1));
+  for (Eigen::Index i = k + 1; i < j; ++i) std::swap(A(i, k), A(j, i));
+}
+
+/// Rank-revealing Cholesky with diagonal pivoting (the algorithm of LAPACK's
+/// dpstrf): each step pivots on the largest diagonal of the remaining Schur
+/// complement and stops when that is at or below `cutoff`; the remainder,
+/// whose diagonal is then all below the cutoff, is what is dropped. H =
+/// P^T L L^T P + remainder with L n x rank in the pivoted order; order[k] is
+/// the variable of pivot k.
+struct PivotedCholesky {
+  Eigen::MatrixXd L;
+  std::vector<int> order;
+};
+
+PivotedCholesky PivotedCholeskyOf(const Eigen::MatrixXd& H_symmetric, double cutoff) {
+  const Eigen::Index n = H_symmetric.rows();
+  Eigen::MatrixXd A = H_symmetric;
+  std::vector<int> order(static_cast<size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) order[i] = static_cast<int>(i);
+  Eigen::Index rank = 0;
+  for (; rank < n; ++rank) {
+    const Eigen::Index k = rank;
+    Eigen::Index j = 0;
+    if (!(A.diagonal().tail(n - k).maxCoeff(&j) > cutoff)) break;
+    j += k;
+    if (j != k) {
+      SymmetricSwap(A, k, j);
+      std::swap(order[k], order[j]);
+    }
+    const double pivot = std::sqrt(A(k, k));
+    A(k, k) = pivot;
+    A.col(k).tail(n - k - 1) /= pivot;
+    for (Eigen::Index c = k + 1; c < n; ++c) {  // the lower triangle of the trailing Schur complement
+      A.col(c).tail(n - c) -= A(c, k) * A.col(k).tail(n - c);
     }
   }
-  const Eigen::MatrixXd Lt_P =
-      (ldlt.transpositionsP().transpose() * Eigen::MatrixXd(ldlt.matrixL())).transpose();
-  const Eigen::VectorXd Linv_P_b = ldlt.matrixL().solve(ldlt.transpositionsP() * b);
-  const Eigen::VectorXd sqrt_D = D(kept).cwiseSqrt();
-  SqrtInformation sqrt{sqrt_D.asDiagonal() * Lt_P(kept, Eigen::all),
-                       sqrt_D.cwiseInverse().asDiagonal() * Linv_P_b(kept)};
-  // On a rank-deficient H (marginalized features leave one) a pivot at the
-  // round-off level can come before larger ones, and the pivots after it are
-  // amplified round-off: then the factor does not give H back, and the
+  PivotedCholesky factor{A.leftCols(rank), std::move(order)};
+  for (Eigen::Index k = 1; k < rank; ++k) factor.L.col(k).head(k).setZero();  // A's upper triangle is H's
+  return factor;
+}
+
+SqrtInformation SqrtByPivotedCholesky(const Eigen::MatrixXd& H, const Eigen::VectorXd& b,
+                                      const RankThreshold& threshold) {
+  const int n = static_cast<int>(H.rows());
+  if (n == 0) {
+    return {Eigen::MatrixXd(0, 0), Eigen::VectorXd(0), Eigen::MatrixXd(0, 0)};
+  }
+  Eigen::MatrixXd H_symmetric = SymmetricPart(H);
+  if (std::optional<SqrtInformation> cholesky = SqrtByCholesky(H_symmetric, b, threshold)) {
+    cholesky->information = std::move(H_symmetric);
+    return *std::move(cholesky);
+  }
+  const double cutoff = EigenvalueCutoff(H_symmetric.diagonal().maxCoeff(), threshold);
+  const PivotedCholesky factor = PivotedCholeskyOf(H_symmetric, cutoff);
+  const Eigen::Index rank = factor.L.cols();
+  // Jp = L^T P: column order[i] of Jp is row i of L; r0 = L11^-1 (P b).
+  SqrtInformation sqrt{Eigen::MatrixXd(rank, n), Eigen::VectorXd(rank), Eigen::MatrixXd()};
+  Eigen::VectorXd Pb(rank);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    sqrt.sqrt_information.col(factor.order[i]) = factor.L.row(i).transpose();
+    if (i < rank) Pb(i) = b(factor.order[i]);
+  }
+  sqrt.residual = factor.L.topRows(rank).triangularView<Eigen::Lower>().solve(Pb);
+  // A remainder that is not round-off (H indefinite beyond it): the
   // eigen-decomposition, which drops exactly the weak directions, is used.
-  const double reconstruction = (sqrt.sqrt_information.transpose() * sqrt.sqrt_information - H).norm();
-  if (!(reconstruction <= kReconstructionTolerance * H.norm())) return SqrtByEigen(H, b, threshold);
+  if (!Reproduces(sqrt.sqrt_information, H)) return SqrtByEigen(H, b, threshold);
+  sqrt.information = std::move(H_symmetric);
   return sqrt;
 }
 
@@ -216,7 +314,7 @@ SqrtInformation SqrtInformationFromHessian(const Eigen::MatrixXd& H, const Eigen
   RequireSizes(H, b, static_cast<int>(H.rows()), 0, "SqrtInformationFromHessian");
   RequireFinite(H, b, "SqrtInformationFromHessian");
   return method == SqrtMethod::kEigen ? SqrtByEigen(H, b, threshold)
-                                      : SqrtByPivotedLdlt(H, b, threshold);
+                                      : SqrtByPivotedCholesky(H, b, threshold);
 }
 
 }  // namespace vio::marginalization

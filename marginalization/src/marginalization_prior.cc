@@ -64,15 +64,33 @@ std::unique_ptr<MarginalizationPrior> MarginalizationPrior::Create(std::vector<B
                                                                    Eigen::VectorXd residual_at_x0) {
   ValidatePrior(blocks, sqrt_information, residual_at_x0);
   return std::unique_ptr<MarginalizationPrior>(new MarginalizationPrior(
-      std::move(blocks), std::move(sqrt_information), std::move(residual_at_x0)));
+      std::move(blocks), std::move(sqrt_information), std::move(residual_at_x0), Eigen::MatrixXd()));
+}
+
+std::unique_ptr<MarginalizationPrior> MarginalizationPrior::Create(std::vector<Block> blocks,
+                                                                   Eigen::MatrixXd sqrt_information,
+                                                                   Eigen::VectorXd residual_at_x0,
+                                                                   Eigen::MatrixXd information) {
+  ValidatePrior(blocks, sqrt_information, residual_at_x0);
+  if (information.rows() != sqrt_information.cols() || information.cols() != sqrt_information.cols() ||
+      !information.allFinite()) {
+    std::ostringstream message;
+    message << "MarginalizationPrior: information is " << information.rows() << "x" << information.cols()
+            << "; expected a finite " << sqrt_information.cols() << "x" << sqrt_information.cols() << " matrix";
+    throw std::invalid_argument(message.str());
+  }
+  return std::unique_ptr<MarginalizationPrior>(new MarginalizationPrior(
+      std::move(blocks), std::move(sqrt_information), std::move(residual_at_x0), std::move(information)));
 }
 
 MarginalizationPrior::MarginalizationPrior(std::vector<Block> blocks,
                                            Eigen::MatrixXd sqrt_information,
-                                           Eigen::VectorXd residual_at_x0)
+                                           Eigen::VectorXd residual_at_x0,
+                                           Eigen::MatrixXd information)
     : blocks_(std::move(blocks)),
       sqrt_information_(std::move(sqrt_information)),
-      residual_at_x0_(std::move(residual_at_x0)) {
+      residual_at_x0_(std::move(residual_at_x0)),
+      information_(std::move(information)) {
   set_num_residuals(static_cast<int>(residual_at_x0_.size()));
   int offset = 0;
   for (const Block& block : blocks_) {
@@ -81,9 +99,11 @@ MarginalizationPrior::MarginalizationPrior(std::vector<Block> blocks,
     tangent_sizes_.push_back(TangentSizeOf(block));
     offset += tangent_sizes_.back();
   }
-  information_ = Eigen::MatrixXd::Zero(offset, offset);
-  information_.selfadjointView<Eigen::Lower>().rankUpdate(sqrt_information_.transpose());
-  information_.triangularView<Eigen::StrictlyUpper>() = information_.transpose();
+  if (information_.size() == 0) {
+    information_ = Eigen::MatrixXd::Zero(offset, offset);
+    information_.selfadjointView<Eigen::Lower>().rankUpdate(sqrt_information_.transpose());
+    information_.triangularView<Eigen::StrictlyUpper>() = information_.transpose();
+  }
   information_vector_ = sqrt_information_.transpose() * residual_at_x0_;
 }
 
@@ -97,6 +117,24 @@ bool MarginalizationPrior::TangentJacobians(double const* const* parameters, Eig
         !MinusTangentJacobian(block, parameters[i], &(*T)[i])) {
       return false;
     }
+  }
+  return true;
+}
+
+bool MarginalizationPrior::TangentNormalEquations(double const* const* parameters, Eigen::MatrixXd* H,
+                                                  Eigen::VectorXd* g, double* cost) const {
+  Eigen::VectorXd delta;
+  std::vector<Eigen::MatrixXd> T;
+  if (!TangentJacobians(parameters, &delta, &T)) return false;
+  *cost = 0.5 * (residual_at_x0_ + sqrt_information_ * delta).squaredNorm();
+  *g = information_vector_ + information_ * delta;
+  *H = information_;
+  for (size_t i = 0; i < blocks_.size(); ++i) {
+    if (T[i].isIdentity(0.0)) continue;
+    const int offset = tangent_offsets_[i], size = tangent_sizes_[i];
+    H->middleRows(offset, size) = T[i].transpose() * H->middleRows(offset, size);
+    H->middleCols(offset, size) = H->middleCols(offset, size) * T[i];
+    g->segment(offset, size) = T[i].transpose() * g->segment(offset, size);
   }
   return true;
 }

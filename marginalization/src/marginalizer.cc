@@ -188,23 +188,79 @@ NormalEquations NormalEquationsOf(const ceres::CRSMatrix& J, const std::vector<d
   return eq;
 }
 
+/// An earlier marginalization prior without a loss: its normal equations come
+/// from its information (O(n^2)) instead of its dense Jacobian (O(n^3)).
+const MarginalizationPrior* AsPrior(const ceres::Problem& problem, ceres::ResidualBlockId id) {
+  if (problem.GetLossFunctionForResidualBlock(id) != nullptr) return nullptr;
+  return dynamic_cast<const MarginalizationPrior*>(problem.GetCostFunctionForResidualBlock(id));
+}
+
+/// Adds a prior's tangent normal equations into `eq` at the blanket columns
+/// of its blocks (-1 in `column_of`: a constant block, skipped).
+void AddPrior(const ceres::Problem& problem, ceres::ResidualBlockId id, const MarginalizationPrior& prior,
+              const std::unordered_map<const double*, int>& column_of, NormalEquations* eq) {
+  std::vector<double*> blocks;
+  problem.GetParameterBlocksForResidualBlock(id, &blocks);
+  Eigen::MatrixXd H;
+  Eigen::VectorXd g;
+  double cost = 0.0;
+  if (!prior.TangentNormalEquations(blocks.data(), &H, &g, &cost)) {
+    throw std::runtime_error("marginalization: a marginalization prior does not evaluate on the Markov blanket");
+  }
+  std::vector<int> columns(blocks.size(), -1);
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    const auto found = column_of.find(blocks[i]);
+    if (found != column_of.end()) columns[i] = found->second;
+  }
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    if (columns[i] < 0) continue;
+    const int oi = prior.tangent_offset(static_cast<int>(i)), ti = prior.tangent_size(static_cast<int>(i));
+    eq->b.segment(columns[i], ti) += g.segment(oi, ti);
+    for (size_t j = 0; j < blocks.size(); ++j) {
+      if (columns[j] < 0) continue;
+      const int oj = prior.tangent_offset(static_cast<int>(j)), tj = prior.tangent_size(static_cast<int>(j));
+      eq->H.block(columns[i], columns[j], ti, tj) += H.block(oi, oj, ti, tj);
+    }
+  }
+}
+
 /// H = J^T J and b = J^T r of the blanket's residual blocks, columns in the
-/// order [kept, marg_dense, marg_uncoupled], on the tangent spaces.
+/// order [kept, marg_dense, marg_uncoupled], on the tangent spaces. Earlier
+/// priors are added from their information, the other blocks from
+/// Problem::Evaluate's Jacobian.
 NormalEquations Linearize(ceres::Problem* problem, const MarkovBlanket& blanket) {
   ceres::Problem::EvaluateOptions evaluate;
-  evaluate.residual_blocks = blanket.residual_blocks;
   evaluate.apply_loss_function = true;
+  std::unordered_map<const double*, int> column_of;
+  int dim = 0;
   for (const auto* group : {&blanket.kept, &blanket.marg_dense, &blanket.marg_uncoupled}) {
-    evaluate.parameter_blocks.insert(evaluate.parameter_blocks.end(), group->begin(), group->end());
+    for (double* block : *group) {
+      evaluate.parameter_blocks.push_back(block);
+      column_of[block] = dim;
+      dim += problem->ParameterBlockTangentSize(block);
+    }
   }
   CHECK(!evaluate.parameter_blocks.empty()) << "an empty list would evaluate every block";
-  double cost = 0.0;
-  std::vector<double> residuals;
-  ceres::CRSMatrix jacobian;
-  if (!problem->Evaluate(evaluate, &cost, &residuals, nullptr, &jacobian)) {
-    throw std::runtime_error("marginalization: Problem::Evaluate failed on the Markov blanket");
+  std::vector<std::pair<ceres::ResidualBlockId, const MarginalizationPrior*>> priors;
+  for (const ceres::ResidualBlockId id : blanket.residual_blocks) {
+    if (const MarginalizationPrior* prior = AsPrior(*problem, id)) {
+      priors.emplace_back(id, prior);
+    } else {
+      evaluate.residual_blocks.push_back(id);
+    }
   }
-  return NormalEquationsOf(jacobian, residuals);
+  NormalEquations eq{Eigen::MatrixXd::Zero(dim, dim), Eigen::VectorXd::Zero(dim)};
+  if (!evaluate.residual_blocks.empty()) {  // an empty list would evaluate every block
+    double cost = 0.0;
+    std::vector<double> residuals;
+    ceres::CRSMatrix jacobian;
+    if (!problem->Evaluate(evaluate, &cost, &residuals, nullptr, &jacobian)) {
+      throw std::runtime_error("marginalization: Problem::Evaluate failed on the Markov blanket");
+    }
+    eq = NormalEquationsOf(jacobian, residuals);
+  }
+  for (const auto& [id, prior] : priors) AddPrior(*problem, id, *prior, column_of, &eq);
+  return eq;
 }
 
 std::vector<MarginalizationPrior::Block> PriorBlocks(const ceres::Problem& problem,
@@ -269,8 +325,9 @@ std::unique_ptr<MarginalizationPrior> BuildPrior(ceres::Problem* problem,
     ReexpressAtFirstEstimates(*problem, blanket.kept, options.first_estimate, sqrt.sqrt_information, &blocks,
                               &sqrt.residual);
   }
-  std::unique_ptr<MarginalizationPrior> prior = MarginalizationPrior::Create(
-      std::move(blocks), std::move(sqrt.sqrt_information), std::move(sqrt.residual));
+  std::unique_ptr<MarginalizationPrior> prior =
+      MarginalizationPrior::Create(std::move(blocks), std::move(sqrt.sqrt_information), std::move(sqrt.residual),
+                                   std::move(sqrt.information));
   if (options.first_estimate) prior->HoldJacobianAtLinearizationPoint();
   return prior;
 }

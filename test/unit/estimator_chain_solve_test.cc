@@ -1,7 +1,7 @@
 // ChainSolver solves H dx = -b exactly as a dense Cholesky of the whole
 // system does, on systems shaped like a window's reduced one: a chain of 9-dim
-// blocks coupled within a band, interleaved with and densely coupled to 6-dim
-// blocks, and refuses (returns false) when H is not positive definite.
+// blocks coupled within a band, interleaved with and densely (or, as in a
+// window, sparsely) coupled to 6-dim blocks, and refuses (returns false) when H is not positive definite.
 #include <random>
 #include <vector>
 
@@ -59,6 +59,25 @@ TEST(ChainSolve, EqualsTheDenseCholeskyStepForEveryBandwidth) {
     const Eigen::VectorXd expected = DenseStep(system);
     EXPECT_LT((dx - expected).norm(), 1e-12 * expected.norm()) << "bandwidth " << bandwidth;
   }
+}
+
+TEST(ChainSolve, EqualsTheDenseStepWithAWindowsSparseCoupling) {
+  // A window's coupling between the chain and the rest: speed/bias block i
+  // touches poses i and i + 1 (IMU factors), the first one every pose (a
+  // prior), and nothing else, so each chain block updates only its rows.
+  const int k = 12;
+  System system = MakeSystem(k, 1, 21);
+  for (int i = 1; i < k; ++i) {
+    for (int p = 0; p < k; ++p) {
+      if (p == i || p == i + 1) continue;
+      system.H.block(6 * p, system.chain[i].offset, 6, 9).setZero();
+      system.H.block(system.chain[i].offset, 6 * p, 9, 6).setZero();
+    }
+  }
+  Eigen::VectorXd dx;
+  ASSERT_TRUE(ChainSolver().Solve(system.H, system.b, system.chain, 1, &dx));
+  const Eigen::VectorXd expected = DenseStep(system);
+  EXPECT_LT((dx - expected).norm(), 1e-12 * expected.norm());
 }
 
 TEST(ChainSolve, AChainAfterOtherColumnsOrAlone) {

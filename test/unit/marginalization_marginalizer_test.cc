@@ -625,8 +625,8 @@ class NonlinearPosesTest : public ::testing::Test {
 };
 
 TEST_F(NonlinearPosesTest, PriorAtTheLinearizationPointIsTheoremTwoTwoTwo) {
-  for (const SqrtMethod method : {SqrtMethod::kEigen, SqrtMethod::kPivotedLdlt}) {
-    SCOPED_TRACE(method == SqrtMethod::kEigen ? "kEigen" : "kPivotedLdlt");
+  for (const SqrtMethod method : {SqrtMethod::kEigen, SqrtMethod::kPivotedCholesky}) {
+    SCOPED_TRACE(method == SqrtMethod::kEigen ? "kEigen" : "kPivotedCholesky");
     MarginalizationOptions options;
     options.sqrt_method = method;
     const MarginalizationResult result = ComputeMarginalization(&problem_, {q0_, p0_}, options);

@@ -235,6 +235,36 @@ TEST_F(MarginalizationPriorTest, CeresGradientCheckerAcceptsTheAmbientJacobians)
   EXPECT_TRUE(checker.Probe(parameters.data(), 1e-6, &results)) << results.error_log;
 }
 
+TEST_F(MarginalizationPriorTest, TangentNormalEquationsAreTheJacobianProducts) {
+  // What the Gauss-Newton solver and the marginalizer assemble from the stored
+  // information equals J^T J, J^T r and 0.5 |r|^2 of the residual and tangent
+  // Jacobian themselves, away from x0 where T_i != I.
+  const auto x = Perturbed(0.3);
+  std::vector<const double*> parameters;
+  for (const auto& block : x) parameters.push_back(block.data());
+  Eigen::MatrixXd H;
+  Eigen::VectorXd g;
+  double cost = 0.0;
+  ASSERT_TRUE(prior_->TangentNormalEquations(parameters.data(), &H, &g, &cost));
+  const Eigen::MatrixXd J = AnalyticTangentJacobian(x);
+  const Eigen::VectorXd r = Residual(x);
+  EXPECT_LE((H - J.transpose() * J).norm(), 1e-12 * H.norm());
+  EXPECT_LE((g - J.transpose() * r).norm(), 1e-12 * g.norm());
+  EXPECT_NEAR(cost, 0.5 * r.squaredNorm(), 1e-12 * cost);
+}
+
+TEST_F(MarginalizationPriorTest, GivenInformationIsKeptAndChecked) {
+  const Eigen::MatrixXd information = Jp_.transpose() * Jp_;
+  std::vector<MarginalizationPrior::Block> blocks = prior_->blocks();
+  const auto given = MarginalizationPrior::Create(blocks, Jp_, r0_, information);
+  EXPECT_EQ(given->information(), information);
+  EXPECT_LE((given->information() - prior_->information()).norm(), 1e-12 * information.norm());
+  EXPECT_THROW(MarginalizationPrior::Create(blocks, Jp_, r0_, information.topRows(3)), std::invalid_argument);
+  Eigen::MatrixXd not_finite = information;
+  not_finite(1, 2) = std::nan("");
+  EXPECT_THROW(MarginalizationPrior::Create(blocks, Jp_, r0_, not_finite), std::invalid_argument);
+}
+
 TEST(MarginalizationPriorCreate, RejectsInconsistentInput) {
   ceres::EigenQuaternionManifold quaternion;
   const Eigen::MatrixXd Jp = Eigen::MatrixXd::Identity(3, 3);

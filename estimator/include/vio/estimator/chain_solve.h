@@ -35,7 +35,8 @@ class ChainSolver {
  private:
   bool FactorChain(const Eigen::MatrixXd& H, const std::vector<ChainBlock>& chain);
   void ForwardSolve(Eigen::Ref<Eigen::MatrixXd> r) const;
-  void BackwardSolve(Eigen::Ref<Eigen::VectorXd> z) const;
+  void BackwardSolve(Eigen::Ref<Eigen::MatrixXd> z) const;
+  void SubtractCoupling();
   const Eigen::MatrixXd& L(int i, int j) const { return below_[i][i - j - 1]; }
   int First(int i) const { return i - bandwidth_ > 0 ? i - bandwidth_ : 0; }
 
@@ -44,11 +45,14 @@ class ChainSolver {
   std::vector<int> rest_;  ///< the columns not in the chain, ascending
   std::vector<Eigen::LLT<Eigen::MatrixXd>> diagonal_;  ///< L(i, i) L(i, i)^T
   std::vector<std::vector<Eigen::MatrixXd>> below_;    ///< below_[i][i - j - 1] = L(i, j), j < i in the band
-  Eigen::MatrixXd X_;  ///< L^-1 H_chain,rest
-  Eigen::MatrixXd S_;  ///< H_rest,rest - X^T X (upper triangle)
-  Eigen::VectorXd y_;  ///< L^-1 b_chain
+  Eigen::MatrixXd B_;  ///< H_chain,rest
+  Eigen::MatrixXd Z_;  ///< H_chain,chain^-1 H_chain,rest
+  Eigen::MatrixXd S_;  ///< H_rest,rest - H_rest,chain Z (upper triangle used)
+  Eigen::VectorXd w_;  ///< H_chain,chain^-1 b_chain
   Eigen::VectorXd dx_rest_;
-  Eigen::VectorXd z_;
+  std::vector<int> coupled_;  ///< scratch: the rest columns one chain block couples to
+  Eigen::MatrixXd B_i_;
+  Eigen::MatrixXd update_;
 };
 
 }  // namespace vio

@@ -36,10 +36,15 @@ enum class SqrtMethod {
   /// H = V diag(lambda) V^T: drops exactly the weakest directions; ~9 n^3
   /// flops (about 0.1 s for n = 400, 0.7 s for n = 700).
   kEigen,
-  /// H = P^T L D L^T P with diagonal pivoting (Eigen::LDLT): the pivots D are
-  /// non-increasing for PSD H, so the dropped part is the trailing pivots;
-  /// ~n^3 / 3 flops, 15-20x faster than kEigen.
-  kPivotedLdlt,
+  /// H = P^T L L^T P + remainder, the rank-revealing Cholesky with diagonal
+  /// pivoting (LAPACK dpstrf's algorithm): it stops when the largest diagonal
+  /// left is below the threshold, and the remainder is dropped; ~n^3 / 3
+  /// flops. When every pivot of the unpivoted blocked Cholesky H = L L^T
+  /// clears the threshold (nothing to drop), that factor is used: the same
+  /// prior up to an orthogonal transform of its rows, 3-5x faster again. Falls
+  /// back to kEigen when the factor does not give H back (H indefinite beyond
+  /// round-off).
+  kPivotedCholesky,
 };
 
 /// Gauss-Newton normal equations of a linearized cost: H = J^T J, b = J^T r.
@@ -52,6 +57,9 @@ struct NormalEquations {
 struct SqrtInformation {
   Eigen::MatrixXd sqrt_information;  ///< Jp, rank x n (rank = kept eigenvalues)
   Eigen::VectorXd residual;          ///< r0, rank
+  /// Jp^T Jp, n x n: the information the factor carries (for kPivotedCholesky
+  /// the factored H itself, which Jp^T Jp reproduces to 1e-13 relative).
+  Eigen::MatrixXd information;
 };
 
 /// Pseudo-inverse of a symmetric PSD matrix via its eigen-decomposition;
@@ -75,10 +83,10 @@ NormalEquations SchurComplementOfUncoupledBlocks(const Eigen::MatrixXd& H, const
                                                  const RankThreshold& threshold = {});
 
 /// Square root (Jp, r0) of (H, b) with Jp^T Jp = H and Jp^T r0 = b, dropping
-/// the factors whose eigenvalue (kEigen) or pivot (kPivotedLdlt) is below the
+/// the factors whose eigenvalue (kEigen) or pivot (kPivotedCholesky) is below the
 /// threshold (b's component there is lost, as it must be):
 ///   kEigen:       H = V diag(l) V^T,     Jp = diag(sqrt(l)) V^T,  r0 = diag(1/sqrt(l)) V^T b;
-///   kPivotedLdlt: H = P^T L D L^T P,     Jp = sqrt(D) L^T P,      r0 = 1/sqrt(D) L^-1 P b.
+///   kPivotedCholesky: H = P^T L L^T P (+ dropped remainder), Jp = L^T P,  r0 = L^-1 P b.
 /// Zero rows when nothing survives the threshold.
 SqrtInformation SqrtInformationFromHessian(const Eigen::MatrixXd& H, const Eigen::VectorXd& b,
                                            const RankThreshold& threshold = {},

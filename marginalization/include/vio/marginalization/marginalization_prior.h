@@ -52,6 +52,13 @@ class MarginalizationPrior final : public ceres::CostFunction {
   static std::unique_ptr<MarginalizationPrior> Create(std::vector<Block> blocks,
                                                       Eigen::MatrixXd sqrt_information,
                                                       Eigen::VectorXd residual_at_x0);
+  /// The same with Jp^T Jp already at hand (`information`, square, of the
+  /// tangent size; the caller vouches that it is Jp^T Jp to round-off), which
+  /// saves forming it (n^2 rows flops).
+  static std::unique_ptr<MarginalizationPrior> Create(std::vector<Block> blocks,
+                                                      Eigen::MatrixXd sqrt_information,
+                                                      Eigen::VectorXd residual_at_x0,
+                                                      Eigen::MatrixXd information);
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
@@ -77,13 +84,19 @@ class MarginalizationPrior final : public ceres::CostFunction {
   /// assemble the normal equations from information() without forming Jp T.
   bool TangentJacobians(double const* const* parameters, Eigen::VectorXd* delta,
                         std::vector<Eigen::MatrixXd>* T) const;
+  /// The prior's normal equations on the stacked tangent spaces at
+  /// `parameters`, from information(): H = T^T (Jp^T Jp) T, g = T^T (Jp^T r0 +
+  /// Jp^T Jp delta) (= J^T r), and cost = 0.5 |r|^2. O(n^2), no Jp T formed.
+  bool TangentNormalEquations(double const* const* parameters, Eigen::MatrixXd* H, Eigen::VectorXd* g,
+                              double* cost) const;
   /// Column of block i in sqrt_information().
   int tangent_offset(int i) const { return tangent_offsets_[i]; }
   int tangent_size(int i) const { return tangent_sizes_[i]; }
 
  private:
+  /// An empty `information` is computed as Jp^T Jp.
   MarginalizationPrior(std::vector<Block> blocks, Eigen::MatrixXd sqrt_information,
-                       Eigen::VectorXd residual_at_x0);
+                       Eigen::VectorXd residual_at_x0, Eigen::MatrixXd information);
 
   /// delta_i = x_i ⊟ x0_i written into the tangent_size(i) values at `delta`.
   bool LocalCoordinates(int i, const double* x, double* delta) const;

@@ -36,8 +36,8 @@ struct MarginalizationOptions {
   RankThreshold rank_threshold;
   /// Factorization of H* into the prior's square root. The blanket of a
   /// sliding window easily has 300-700 dimensions, where kEigen costs
-  /// 0.1-0.7 s and kPivotedLdlt 15-20x less.
-  SqrtMethod sqrt_method = SqrtMethod::kPivotedLdlt;
+  /// 0.1-0.7 s and kPivotedCholesky 15-20x less.
+  SqrtMethod sqrt_method = SqrtMethod::kPivotedCholesky;
   /// The order in which residual blocks are summed, when not empty (it must
   /// hold every residual block touching a marginalized block). Empty: the
   /// problem's order, which Ceres' block removal makes depend on addresses.
