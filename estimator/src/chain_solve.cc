@@ -63,19 +63,22 @@ void ChainSolver::BackwardSolve(Eigen::Ref<Eigen::MatrixXd> z) const {
 
 // S = H_rr - H_rc Z with Z = H_cc^-1 H_cr, row block by chain block: chain
 // block i touches only the rest columns its rows of H_cr are non-zero in (the
-// IMU factors: two poses; a prior: the poses it spans), so this costs
-// nnz(H_cr) x rest instead of the chain x rest^2 of forming (L^-1 H_cr)^T (L^-1 H_cr).
+// IMU factors: two poses; a prior: the poses it spans), in runs of adjacent
+// columns, so this costs nnz(H_cr) x rest instead of the chain x rest^2 of
+// forming (L^-1 H_cr)^T (L^-1 H_cr). Only S's upper triangle is formed.
 void ChainSolver::SubtractCoupling() {
+  const int nr = static_cast<int>(rest_.size());
   for (size_t i = 0; i < rows_.size(); ++i) {
     const int size = static_cast<int>(diagonal_[i].rows());
-    coupled_.clear();
-    for (int j = 0; j < static_cast<int>(rest_.size()); ++j) {
-      if (!B_.block(rows_[i], j, size, 1).isZero(0.0)) coupled_.push_back(j);
+    const auto coupled = [&](int j) { return j < nr && !B_.block(rows_[i], j, size, 1).isZero(0.0); };
+    for (int first = 0; first < nr; ++first) {
+      if (!coupled(first)) continue;
+      int end = first + 1;
+      while (coupled(end)) ++end;
+      S_.block(first, first, end - first, nr - first).noalias() -=
+          B_.block(rows_[i], first, size, end - first).transpose() * Z_.block(rows_[i], first, size, nr - first);
+      first = end;
     }
-    if (coupled_.empty()) continue;
-    B_i_ = B_(Eigen::seqN(rows_[i], size), coupled_);
-    update_.noalias() = B_i_.transpose() * Z_.middleRows(rows_[i], size);
-    S_(coupled_, Eigen::all) -= update_;
   }
 }
 

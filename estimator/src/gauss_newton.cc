@@ -36,7 +36,11 @@ struct Slot {
   int eliminated = -1;  ///< eliminated block index, -1 for none
   int coupling = -1;    ///< a dense block next to an eliminated one: its index in that block's `coupled`
   int tangent = 0;      ///< tangent size
+  int ambient = 0;      ///< ambient (parameter block) size
   int jacobian = 0;     ///< offset of its (rows x tangent, row-major) Jacobian in the scratch buffer
+  /// The block's PlusJacobian (ambient x tangent, row-major) in the solver's
+  /// per-step cache; nullptr for a Euclidean block (the identity).
+  const RowMajorMatrix* plus_jacobian = nullptr;
   bool variable() const { return dense >= 0 || eliminated >= 0; }
 };
 
@@ -70,6 +74,22 @@ struct PendingUpdate {
   int rows = 0;
   int block = 0;  ///< the eliminated block holding U
 };
+
+/// tangent = ambient * plus_jacobian on fixed-size row-major blocks.
+template <int Rows, int Ambient, int Tangent>
+void ToTangent(const double* ambient, const double* plus_jacobian, double* tangent) {
+  Eigen::Map<Eigen::Matrix<double, Rows, Tangent, Eigen::RowMajor>>(tangent).noalias() =
+      Eigen::Map<const Eigen::Matrix<double, Rows, Ambient, Eigen::RowMajor>>(ambient) *
+      Eigen::Map<const Eigen::Matrix<double, Ambient, Tangent, Eigen::RowMajor>>(plus_jacobian);
+}
+
+/// Ceres' Corrector on one row-major Jacobian: J <- sqrt_rho1 (J - alpha_sq_norm r (r^T J)).
+template <int Rows, typename Residuals>
+void CorrectJacobian(const Residuals& res, double alpha_sq_norm, double sqrt_rho1, int tangent, double* jacobian) {
+  Eigen::Map<Eigen::Matrix<double, Rows, Eigen::Dynamic, Eigen::RowMajor>> J(jacobian, res.size(), tangent);
+  if (alpha_sq_norm != 0.0) J -= alpha_sq_norm * res * (res.transpose() * J);
+  J *= sqrt_rho1;
+}
 
 void ApplyStep(ceres::Problem* problem, const std::vector<double*>& blocks, const Eigen::VectorXd& dx,
                int first_col) {
@@ -134,7 +154,12 @@ struct GaussNewtonSolver::System {
   std::vector<double> before_step;
   std::vector<double> r;
   std::vector<double> jacobians;
+  std::vector<double> ambient_jacobians;  ///< what the cost function writes for blocks with a manifold
   std::vector<double*> jacobian_pointers;
+  /// PlusJacobian at the current values of every variable block with a
+  /// manifold (dense, then eliminated blocks), refreshed once per assembly.
+  std::vector<RowMajorMatrix> plus_jacobians;
+  std::vector<std::pair<const ceres::Manifold*, const double*>> manifold_blocks;
   Eigen::MatrixXd prior_H;
   Eigen::VectorXd prior_g;
   Eigen::MatrixXd U;
@@ -159,10 +184,22 @@ struct GaussNewtonSolver::System {
       col += eliminated[k].columns.size;
       index[layout.eliminated[k]] = {-1, static_cast<int>(k)};
     }
-    size_t scratch = 0;
-    for (ceres::ResidualBlockId id : layout.residuals) {
-      scratch = std::max(scratch, AddResidual(id, index));
+    for (const std::vector<double*>* blocks : {&layout.dense, &layout.eliminated}) {
+      for (const double* block : *blocks) {
+        if (const ceres::Manifold* manifold = problem->GetManifold(block)) manifold_blocks.emplace_back(manifold, block);
+      }
     }
+    plus_jacobians.resize(manifold_blocks.size());
+    std::unordered_map<const double*, const RowMajorMatrix*> plus_jacobian_of;
+    for (size_t k = 0; k < manifold_blocks.size(); ++k) plus_jacobian_of[manifold_blocks[k].second] = &plus_jacobians[k];
+    size_t scratch = 0;
+    size_t ambient_scratch = 0;
+    for (ceres::ResidualBlockId id : layout.residuals) {
+      const auto [tangent_size, ambient_size] = AddResidual(id, index, plus_jacobian_of);
+      scratch = std::max(scratch, tangent_size);
+      ambient_scratch = std::max(ambient_scratch, ambient_size);
+    }
+    ambient_jacobians.resize(ambient_scratch);
     for (EliminatedBlock& block : eliminated) {
       std::sort(block.coupled.begin(), block.coupled.end());
       block.coupled.erase(std::unique(block.coupled.begin(), block.coupled.end()), block.coupled.end());
@@ -207,9 +244,11 @@ struct GaussNewtonSolver::System {
     for (const int d : layout.chain) chain.push_back({dense[d].offset, dense[d].size});
   }
 
-  // The residual's slots; returns the scratch its Jacobians need.
-  size_t AddResidual(ceres::ResidualBlockId id,
-                     const std::unordered_map<const double*, std::pair<int, int>>& index) {
+  // The residual's slots; returns the scratch its tangent Jacobians and its
+  // ambient ones (blocks with a manifold) need.
+  std::pair<size_t, size_t> AddResidual(ceres::ResidualBlockId id,
+                                        const std::unordered_map<const double*, std::pair<int, int>>& index,
+                                        const std::unordered_map<const double*, const RowMajorMatrix*>& plus_jacobian_of) {
     Residual& residual = residuals.emplace_back();
     residual.id = id;
     const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(id);
@@ -218,9 +257,12 @@ struct GaussNewtonSolver::System {
     residual.rows = cost->num_residuals();
     problem->GetParameterBlocksForResidualBlock(id, &residual.values);
     int jacobian = 0;
+    int ambient = 0;
     for (const double* value : residual.values) {
       Slot slot;
       slot.tangent = problem->ParameterBlockTangentSize(value);
+      slot.ambient = problem->ParameterBlockSize(value);
+      if (const auto it = plus_jacobian_of.find(value); it != plus_jacobian_of.end()) slot.plus_jacobian = it->second;
       if (const auto it = index.find(value); it != index.end()) {
         std::tie(slot.dense, slot.eliminated) = it->second;
       }
@@ -231,6 +273,7 @@ struct GaussNewtonSolver::System {
       }
       slot.jacobian = jacobian;
       if (slot.variable()) jacobian += residual.rows * slot.tangent;
+      if (slot.variable() && slot.plus_jacobian != nullptr) ambient = std::max(ambient, residual.rows * slot.ambient);
       residual.slots.push_back(slot);
     }
     if (residual.eliminated >= 0) {
@@ -242,7 +285,7 @@ struct GaussNewtonSolver::System {
     }
     r.resize(std::max(r.size(), static_cast<size_t>(residual.rows)));
     jacobian_pointers.resize(std::max(jacobian_pointers.size(), residual.values.size()));
-    return static_cast<size_t>(jacobian);
+    return {static_cast<size_t>(jacobian), static_cast<size_t>(ambient) * residual.values.size()};
   }
 
   void Zero() {
@@ -281,14 +324,7 @@ struct GaussNewtonSolver::System {
   }
 
   bool AddGeneric(const Residual& residual, double* cost) {
-    for (size_t k = 0; k < residual.slots.size(); ++k) {
-      const Slot& slot = residual.slots[k];
-      jacobian_pointers[k] = slot.variable() ? jacobians.data() + slot.jacobian : nullptr;
-    }
-    if (!problem->EvaluateResidualBlock(residual.id, /*apply_loss_function=*/true, cost, r.data(),
-                                        jacobian_pointers.data())) {
-      return false;
-    }
+    if (!EvaluateOnTangents(residual, cost)) return false;
     // A stereo residual (3 rows on 6- and 3-dimensional tangents) takes
     // fixed-size products; every other shape the dynamic ones.
     if (residual.rows == 3 && HasTangentsOf3Or6(residual)) {
@@ -306,6 +342,81 @@ struct GaussNewtonSolver::System {
                [&](const Slot& slot, const auto& use) {
                  use(ConstJacobian(jacobians.data() + slot.jacobian, residual.rows, slot.tangent));
                });
+    return true;
+  }
+
+  // What Problem::EvaluateResidualBlock(apply_loss_function = true) gives,
+  // without its per-call bookkeeping: the cost 0.5 rho(|r|^2), the residual
+  // and the tangent Jacobians (ambient ones times the step's cached
+  // PlusJacobian) corrected for the loss as Ceres' Corrector does (Triggs et
+  // al.: J <- sqrt(rho') (J - alpha r r^T J / |r|^2), r <- sqrt(rho') r / (1 - alpha)).
+  // False when the cost function fails or gives a non-finite value.
+  bool EvaluateOnTangents(const Residual& residual, double* cost) {
+    const int rows = residual.rows;
+    for (size_t k = 0, ambient = 0; k < residual.slots.size(); ++k) {
+      const Slot& slot = residual.slots[k];
+      if (!slot.variable()) {
+        jacobian_pointers[k] = nullptr;
+      } else if (slot.plus_jacobian == nullptr) {
+        jacobian_pointers[k] = jacobians.data() + slot.jacobian;
+      } else {
+        jacobian_pointers[k] = ambient_jacobians.data() + ambient;
+        ambient += static_cast<size_t>(rows * slot.ambient);
+      }
+    }
+    if (!residual.cost->Evaluate(residual.values.data(), r.data(), jacobian_pointers.data())) return false;
+    Eigen::Map<Eigen::VectorXd> res(r.data(), rows);
+    if (!res.allFinite()) return false;
+    for (size_t k = 0; k < residual.slots.size(); ++k) {
+      const Slot& slot = residual.slots[k];
+      if (!slot.variable()) continue;
+      double* tangent = jacobians.data() + slot.jacobian;
+      if (slot.plus_jacobian != nullptr) {
+        if (rows == 3 && slot.ambient == 7 && slot.tangent == 6) {  // a stereo residual on a pose
+          ToTangent<3, 7, 6>(jacobian_pointers[k], slot.plus_jacobian->data(), tangent);
+        } else {
+          Eigen::Map<RowMajorMatrix>(tangent, rows, slot.tangent).noalias() =
+              Eigen::Map<const RowMajorMatrix>(jacobian_pointers[k], rows, slot.ambient) * *slot.plus_jacobian;
+        }
+      }
+      if (!Eigen::Map<const Eigen::VectorXd>(tangent, rows * slot.tangent).allFinite()) return false;
+    }
+    const double squared_norm = res.squaredNorm();
+    if (residual.loss == nullptr) {
+      *cost = 0.5 * squared_norm;
+      return true;
+    }
+    double rho[3];
+    residual.loss->Evaluate(squared_norm, rho);
+    *cost = 0.5 * rho[0];
+    const double sqrt_rho1 = std::sqrt(rho[1]);
+    double residual_scaling = sqrt_rho1;
+    double alpha_sq_norm = 0.0;
+    if (squared_norm != 0.0 && rho[2] > 0.0) {
+      const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * squared_norm * rho[2] / rho[1]);
+      residual_scaling = sqrt_rho1 / (1.0 - alpha);
+      alpha_sq_norm = alpha / squared_norm;
+    }
+    for (const Slot& slot : residual.slots) {
+      if (!slot.variable()) continue;
+      double* J = jacobians.data() + slot.jacobian;
+      if (rows == 3) {
+        CorrectJacobian<3>(Eigen::Map<const Eigen::Vector3d>(r.data()), alpha_sq_norm, sqrt_rho1, slot.tangent, J);
+      } else {
+        CorrectJacobian<Eigen::Dynamic>(res, alpha_sq_norm, sqrt_rho1, slot.tangent, J);
+      }
+    }
+    res *= residual_scaling;
+    return std::isfinite(*cost);
+  }
+
+  // PlusJacobian of every variable block with a manifold at the current values.
+  bool RefreshPlusJacobians() {
+    for (size_t k = 0; k < manifold_blocks.size(); ++k) {
+      const auto& [manifold, values] = manifold_blocks[k];
+      plus_jacobians[k].resize(manifold->AmbientSize(), manifold->TangentSize());
+      if (!manifold->PlusJacobian(values, plus_jacobians[k].data())) return false;
+    }
     return true;
   }
 
@@ -365,6 +476,7 @@ struct GaussNewtonSolver::System {
   }
 
   bool Assemble(double* cost) {
+    if (!RefreshPlusJacobians()) return false;
     Zero();
     *cost = 0;
     for (const Residual& residual : residuals) {

@@ -10,6 +10,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <glog/logging.h>
 
 namespace vio::marginalization {
@@ -56,10 +57,21 @@ double EigenvalueCutoff(double largest_eigenvalue, const RankThreshold& threshol
 }
 
 /// PseudoInverse of a 3x3 block (every landmark of a Schur elimination) on
-/// fixed-size matrices, without heap allocation: the same decomposition and
+/// fixed-size matrices, without heap allocation: the closed-form inverse when
+/// no eigenvalue can be below the cutoff, else the same decomposition and
 /// cutoff as DecomposeSignificant.
 Eigen::Matrix3d PseudoInverse3(const Eigen::Matrix3d& H, const RankThreshold& threshold) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(0.5 * (H + H.transpose()));
+  const Eigen::Matrix3d S = 0.5 * (H + H.transpose());
+  // Clearly definite (Sylvester's minors), with lambda_min >= det / trace^2
+  // above the cutoff (relative to lambda_max <= trace): no eigenvalue is
+  // dropped and the pseudo-inverse is the inverse, in closed form.
+  const double trace = S.trace();
+  const double det = S.determinant();
+  if (S(0, 0) > 0.0 && S(0, 0) * S(1, 1) - S(0, 1) * S(0, 1) > 0.0 &&
+      det > EigenvalueCutoff(trace, threshold) * trace * trace) {
+    return S.inverse();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(S);
   CHECK(solver.info() == Eigen::Success) << "eigen-decomposition of a finite symmetric matrix failed";
   const Eigen::Vector3d& lambda = solver.eigenvalues();
   const double cutoff = EigenvalueCutoff(lambda.maxCoeff(), threshold);

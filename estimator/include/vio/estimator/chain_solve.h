@@ -50,9 +50,6 @@ class ChainSolver {
   Eigen::MatrixXd S_;  ///< H_rest,rest - H_rest,chain Z (upper triangle used)
   Eigen::VectorXd w_;  ///< H_chain,chain^-1 b_chain
   Eigen::VectorXd dx_rest_;
-  std::vector<int> coupled_;  ///< scratch: the rest columns one chain block couples to
-  Eigen::MatrixXd B_i_;
-  Eigen::MatrixXd update_;
 };
 
 }  // namespace vio
