@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "vio/estimator/chain_solve.h"
+#include "vio/estimator/tangent_cost_function.h"
 #include "vio/marginalization/linear_algebra.h"
 #include "vio/marginalization/marginalization_prior.h"
 
@@ -49,6 +50,8 @@ struct Residual {
   ceres::ResidualBlockId id = nullptr;
   const ceres::CostFunction* cost = nullptr;
   const ceres::LossFunction* loss = nullptr;  ///< nullptr: none
+  /// The same cost function when it gives tangent Jacobians itself.
+  const TangentCostFunction* on_tangents = nullptr;
   int rows = 0;
   /// A marginalization prior on dense blocks only: assembled from its information.
   const marginalization::MarginalizationPrior* prior = nullptr;
@@ -254,6 +257,7 @@ struct GaussNewtonSolver::System {
     const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(id);
     residual.cost = cost;
     residual.loss = problem->GetLossFunctionForResidualBlock(id);
+    residual.on_tangents = dynamic_cast<const TangentCostFunction*>(cost);
     residual.rows = cost->num_residuals();
     problem->GetParameterBlocksForResidualBlock(id, &residual.values);
     int jacobian = 0;
@@ -347,31 +351,35 @@ struct GaussNewtonSolver::System {
 
   // What Problem::EvaluateResidualBlock(apply_loss_function = true) gives,
   // without its per-call bookkeeping: the cost 0.5 rho(|r|^2), the residual
-  // and the tangent Jacobians (ambient ones times the step's cached
-  // PlusJacobian) corrected for the loss as Ceres' Corrector does (Triggs et
+  // and the tangent Jacobians (from a TangentCostFunction directly, else
+  // ambient ones times the step's cached PlusJacobian) corrected for the loss as Ceres' Corrector does (Triggs et
   // al.: J <- sqrt(rho') (J - alpha r r^T J / |r|^2), r <- sqrt(rho') r / (1 - alpha)).
   // False when the cost function fails or gives a non-finite value.
   bool EvaluateOnTangents(const Residual& residual, double* cost) {
     const int rows = residual.rows;
+    const bool on_tangents = residual.on_tangents != nullptr;  // no ambient round trip
     for (size_t k = 0, ambient = 0; k < residual.slots.size(); ++k) {
       const Slot& slot = residual.slots[k];
       if (!slot.variable()) {
         jacobian_pointers[k] = nullptr;
-      } else if (slot.plus_jacobian == nullptr) {
+      } else if (slot.plus_jacobian == nullptr || on_tangents) {
         jacobian_pointers[k] = jacobians.data() + slot.jacobian;
       } else {
         jacobian_pointers[k] = ambient_jacobians.data() + ambient;
         ambient += static_cast<size_t>(rows * slot.ambient);
       }
     }
-    if (!residual.cost->Evaluate(residual.values.data(), r.data(), jacobian_pointers.data())) return false;
+    const bool evaluated =
+        on_tangents ? residual.on_tangents->EvaluateOnTangents(residual.values.data(), r.data(), jacobian_pointers.data())
+                    : residual.cost->Evaluate(residual.values.data(), r.data(), jacobian_pointers.data());
+    if (!evaluated) return false;
     Eigen::Map<Eigen::VectorXd> res(r.data(), rows);
     if (!res.allFinite()) return false;
     for (size_t k = 0; k < residual.slots.size(); ++k) {
       const Slot& slot = residual.slots[k];
       if (!slot.variable()) continue;
       double* tangent = jacobians.data() + slot.jacobian;
-      if (slot.plus_jacobian != nullptr) {
+      if (slot.plus_jacobian != nullptr && !on_tangents) {
         if (rows == 3 && slot.ambient == 7 && slot.tangent == 6) {  // a stereo residual on a pose
           ToTangent<3, 7, 6>(jacobian_pointers[k], slot.plus_jacobian->data(), tangent);
         } else {
@@ -489,8 +497,9 @@ struct GaussNewtonSolver::System {
 
   /// Schur complement of the eliminated blocks into (H, b), block by block:
   /// with H_inv = S S^T, U = [W_1; ...; W_m] S, the update is one rank-n
-  /// update H -= U U^T over the coupled columns (in place when they are
-  /// contiguous, grouped by row range: SubtractPendingUpdates) and b -= U S^T b_e.
+  /// update H -= U U^T over the coupled columns (in place over their span,
+  /// with zero rows in its gaps, grouped by row range: SubtractPendingUpdates;
+  /// pair by pair when the span is mostly gaps) and b -= U S^T b_e.
   void Eliminate() {
     pending.clear();
     for (size_t k = 0; k < eliminated.size(); ++k) {
@@ -501,21 +510,27 @@ struct GaussNewtonSolver::System {
         EliminatePairwise(block);
         continue;
       }
+      if (block.coupled.empty()) continue;
+      // U over the span of its coupled columns, zero rows in the gaps (a
+      // track that skipped a frame): one contiguous update unless the span is
+      // mostly gaps.
+      const int first = dense[block.coupled.front()].offset;
+      const int span = dense[block.coupled.back()].offset + dense[block.coupled.back()].size - first;
       int rows = 0;
-      bool contiguous = true;
-      for (size_t p = 0; p < block.coupled.size(); ++p) {
-        const Columns& a = dense[block.coupled[p]];
-        if (p > 0) {
-          const Columns& previous = dense[block.coupled[p - 1]];
-          contiguous = contiguous && a.offset == previous.offset + previous.size;
+      for (const int d : block.coupled) rows += dense[d].size;
+      const bool contiguous = span <= 2 * rows;
+      if (contiguous) {
+        U.setZero(span, block.columns.size);
+        for (size_t p = 0; p < block.coupled.size(); ++p) {
+          U.middleRows(dense[block.coupled[p]].offset - first, block.W[p].rows()) = block.W[p];
         }
-        rows += a.size;
-      }
-      U.resize(rows, block.columns.size);
-      rows = 0;
-      for (size_t p = 0; p < block.coupled.size(); ++p) {
-        U.middleRows(rows, block.W[p].rows()) = block.W[p];
-        rows += static_cast<int>(block.W[p].rows());
+      } else {
+        U.resize(rows, block.columns.size);
+        rows = 0;
+        for (size_t p = 0; p < block.coupled.size(); ++p) {
+          U.middleRows(rows, block.W[p].rows()) = block.W[p];
+          rows += static_cast<int>(block.W[p].rows());
+        }
       }
       if (U.cols() == 3) {  // a landmark: the 3x3 factor on fixed-size, coefficient by coefficient
         const Eigen::Matrix3d L = factor.matrixL();
@@ -525,18 +540,17 @@ struct GaussNewtonSolver::System {
         U = U * factor.matrixL();
       }
       const Eigen::VectorXd c = factor.matrixU() * block.b;
+      if (contiguous) {
+        b.segment(first, span).noalias() -= U * c;
+        block.U = U;
+        pending.push_back({first, span, static_cast<int>(k)});
+        continue;
+      }
       rows = 0;
       for (size_t p = 0; p < block.coupled.size(); ++p) {
         const Columns& a = dense[block.coupled[p]];
         b.segment(a.offset, a.size).noalias() -= U.middleRows(rows, a.size) * c;
         rows += a.size;
-      }
-      if (block.coupled.empty()) continue;
-      const int first = dense[block.coupled.front()].offset;
-      if (contiguous) {
-        block.U = U;
-        pending.push_back({first, rows, static_cast<int>(k)});
-        continue;
       }
       UUt.setZero(rows, rows);
       UUt.selfadjointView<Eigen::Upper>().rankUpdate(U);

@@ -89,15 +89,32 @@ ImuFactor::Vector15d ImuFactor::UnwhitenedResidual(double const* const* paramete
 
 bool ImuFactor::Evaluate(double const* const* parameters, double* residuals,
                          double** jacobians) const {
+  return EvaluateImpl(parameters, residuals, jacobians, /*on_tangents=*/false);
+}
+
+bool ImuFactor::EvaluateOnTangents(double const* const* parameters, double* residuals,
+                                   double** jacobians) const {
+  return EvaluateImpl(parameters, residuals, jacobians, /*on_tangents=*/true);
+}
+
+bool ImuFactor::EvaluateImpl(double const* const* parameters, double* residuals, double** jacobians,
+                             bool on_tangents) const {
   const States states(parameters);
   const Linearization lin = Linearize(states);
   Eigen::Map<Vector15d>{residuals} = sqrt_information_ * lin.residual;
-  if (jacobians != nullptr) WriteJacobians(states, lin, jacobians);
+  if (jacobians != nullptr) WriteJacobians(states, lin, jacobians, on_tangents);
   return true;
 }
 
-void ImuFactor::WriteJacobians(const States& s, const Linearization& lin,
-                               double** jacobians) const {
+void ImuFactor::WriteJacobians(const States& s, const Linearization& lin, double** jacobians,
+                               bool on_tangents) const {
+  const auto write_pose = [on_tangents](const Matrix15x6d& J, const Eigen::Quaterniond& q, double* out) {
+    if (on_tangents) {
+      Eigen::Map<Eigen::Matrix<double, 15, 6, Eigen::RowMajor>>{out} = J;
+    } else {
+      PoseJacobianToAmbient<15>(J, q, out);
+    }
+  };
   const double dt = preintegration_.delta_time_s();
   const Eigen::Matrix3d Jr_inv = so3::RightJacobianInverse(lin.residual.segment<3>(kR));
   const Eigen::Matrix3d R_i_T = s.R_i.transpose();
@@ -109,7 +126,7 @@ void ImuFactor::WriteJacobians(const States& s, const Linearization& lin,
     J.block<3, 3>(kV, kTangentRotation) = so3::Hat(lin.velocity_i);
     J.block<3, 3>(kP, kTangentPosition) = -R_i_T;
     J.block<3, 3>(kP, kTangentRotation) = so3::Hat(lin.position_i);
-    PoseJacobianToAmbient<15>(sqrt_information_ * J, s.q_i, jacobians[0]);
+    write_pose(sqrt_information_ * J, s.q_i, jacobians[0]);
   }
   if (jacobians[1] != nullptr) {  // speed_bias_i
     Matrix15x9d J = Matrix15x9d::Zero();
@@ -129,7 +146,7 @@ void ImuFactor::WriteJacobians(const States& s, const Linearization& lin,
     Matrix15x6d J = Matrix15x6d::Zero();
     J.block<3, 3>(kR, kTangentRotation) = Jr_inv;
     J.block<3, 3>(kP, kTangentPosition) = R_i_T;
-    PoseJacobianToAmbient<15>(sqrt_information_ * J, s.q_j, jacobians[2]);
+    write_pose(sqrt_information_ * J, s.q_j, jacobians[2]);
   }
   if (jacobians[3] != nullptr) {  // speed_bias_j
     Matrix15x9d J = Matrix15x9d::Zero();

@@ -72,6 +72,16 @@ bool StereoFactor::Project(const RectifiedStereo& stereo, const Eigen::Vector3d&
 
 bool StereoFactor::Evaluate(double const* const* parameters, double* residuals,
                             double** jacobians) const {
+  return EvaluateImpl(parameters, residuals, jacobians, /*on_tangents=*/false);
+}
+
+bool StereoFactor::EvaluateOnTangents(double const* const* parameters, double* residuals,
+                                      double** jacobians) const {
+  return EvaluateImpl(parameters, residuals, jacobians, /*on_tangents=*/true);
+}
+
+bool StereoFactor::EvaluateImpl(double const* const* parameters, double* residuals, double** jacobians,
+                                bool on_tangents) const {
   const Eigen::Map<const Eigen::Vector3d> p_w_b(parameters[0]);
   const Eigen::Quaterniond q_w_b =
       Eigen::Map<const Eigen::Quaterniond>(parameters[0] + 3).normalized();
@@ -91,7 +101,11 @@ bool StereoFactor::Evaluate(double const* const* parameters, double* residuals,
     Eigen::Matrix<double, 3, 6> J_tangent;
     J_tangent.leftCols<3>() = -de_dp_c * R_c_w;
     J_tangent.rightCols<3>() = de_dp_c * point.R_c_b * so3::Hat(point.p_b);
-    PoseJacobianToAmbient<3>(J_tangent, q_w_b, jacobians[0]);
+    if (on_tangents) {
+      Eigen::Map<Eigen::Matrix<double, 3, 6, Eigen::RowMajor>>{jacobians[0]} = J_tangent;
+    } else {
+      PoseJacobianToAmbient<3>(J_tangent, q_w_b, jacobians[0]);
+    }
   }
   if (jacobians[1] != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>{jacobians[1]} = de_dp_c * R_c_w;

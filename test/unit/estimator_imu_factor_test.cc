@@ -104,6 +104,8 @@ TEST(ImuFactor, JacobiansMatchCentralDifferencesOnTheTangentSpace) {
     }
     test::ExpectTangentJacobiansMatch(factor, blocks, {&pose_manifold, nullptr, &pose_manifold, nullptr},
                                       1e-6);
+    test::ExpectTangentEvaluationMatchesAmbient(factor, blocks,
+                                                {&pose_manifold, nullptr, &pose_manifold, nullptr});
   }
 }
 

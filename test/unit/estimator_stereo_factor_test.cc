@@ -73,6 +73,8 @@ TEST(StereoFactor, JacobiansMatchCentralDifferencesOnTheTangentSpace) {
     const StereoFactor factor(Eigen::Vector3d(300.0, 280.0, 200.0), stereo, 0.8);
     test::ExpectTangentJacobiansMatch(factor, {PoseBlock(p_w_b, q_w_b), {p_w_l.x(), p_w_l.y(), p_w_l.z()}},
                                       {&pose_manifold, nullptr}, 1e-6);
+    test::ExpectTangentEvaluationMatchesAmbient(
+        factor, {PoseBlock(p_w_b, q_w_b), {p_w_l.x(), p_w_l.y(), p_w_l.z()}}, {&pose_manifold, nullptr});
   }
 }
 

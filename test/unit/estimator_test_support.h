@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 
 #include "vio/estimator/so3.h"
+#include "vio/estimator/tangent_cost_function.h"
 #include "vio/estimator/types.h"
 
 namespace vio::test {
@@ -193,6 +194,45 @@ inline void ExpectTangentJacobiansMatch(const ceres::CostFunction& cost,
     const double error = (analytic[b] - numeric[b]).norm();
     EXPECT_LE(error, relative_tolerance * std::max(numeric[b].norm(), 1.0))
         << "block " << b << "\nanalytic:\n" << analytic[b] << "\nnumeric:\n" << numeric[b];
+  }
+}
+
+/// A TangentCostFunction's tangent Jacobians equal its ambient ones times
+/// each manifold's PlusJacobian (nullptr: Euclidean), and its residual is the
+/// same, to `relative_tolerance`.
+inline void ExpectTangentEvaluationMatchesAmbient(const ceres::CostFunction& cost,
+                                                  const std::vector<std::vector<double>>& parameters,
+                                                  const std::vector<const ceres::Manifold*>& manifolds,
+                                                  double relative_tolerance = 1e-12) {
+  const auto* on_tangents = dynamic_cast<const TangentCostFunction*>(&cost);
+  ASSERT_NE(on_tangents, nullptr);
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const int rows = cost.num_residuals();
+  std::vector<const double*> values;
+  std::vector<RowMajor> ambient, tangent;
+  std::vector<double*> ambient_pointers, tangent_pointers;
+  for (size_t b = 0; b < parameters.size(); ++b) {
+    values.push_back(parameters[b].data());
+    const int size = static_cast<int>(parameters[b].size());
+    ambient.emplace_back(rows, size);
+    tangent.emplace_back(rows, manifolds[b] != nullptr ? manifolds[b]->TangentSize() : size);
+  }
+  for (size_t b = 0; b < parameters.size(); ++b) {
+    ambient_pointers.push_back(ambient[b].data());
+    tangent_pointers.push_back(tangent[b].data());
+  }
+  Eigen::VectorXd r_ambient(rows), r_tangent(rows);
+  ASSERT_TRUE(cost.Evaluate(values.data(), r_ambient.data(), ambient_pointers.data()));
+  ASSERT_TRUE(on_tangents->EvaluateOnTangents(values.data(), r_tangent.data(), tangent_pointers.data()));
+  EXPECT_EQ(r_tangent, r_ambient);
+  for (size_t b = 0; b < parameters.size(); ++b) {
+    RowMajor expected = ambient[b];
+    if (manifolds[b] != nullptr) {
+      RowMajor plus(manifolds[b]->AmbientSize(), manifolds[b]->TangentSize());
+      ASSERT_TRUE(manifolds[b]->PlusJacobian(parameters[b].data(), plus.data()));
+      expected = ambient[b] * plus;
+    }
+    EXPECT_LE((tangent[b] - expected).norm(), relative_tolerance * std::max(expected.norm(), 1.0)) << "block " << b;
   }
 }
 

@@ -34,10 +34,11 @@
 #include <Eigen/Core>
 
 #include "vio/estimator/imu_preintegration.h"
+#include "vio/estimator/tangent_cost_function.h"
 
 namespace vio {
 
-class ImuFactor final : public ceres::SizedCostFunction<15, 7, 9, 7, 9> {
+class ImuFactor final : public ceres::SizedCostFunction<15, 7, 9, 7, 9>, public TangentCostFunction {
  public:
   using Vector15d = Eigen::Matrix<double, 15, 1>;
 
@@ -51,6 +52,8 @@ class ImuFactor final : public ceres::SizedCostFunction<15, 7, 9, 7, 9> {
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
+  bool EvaluateOnTangents(double const* const* parameters, double* residuals,
+                          double** jacobians) const override;
 
   /// The residual r before whitening (diagnostics).
   Vector15d UnwhitenedResidual(double const* const* parameters) const;
@@ -63,7 +66,8 @@ class ImuFactor final : public ceres::SizedCostFunction<15, 7, 9, 7, 9> {
   struct Linearization;
 
   Linearization Linearize(const States& states) const;
-  void WriteJacobians(const States& states, const Linearization& lin, double** jacobians) const;
+  bool EvaluateImpl(double const* const* parameters, double* residuals, double** jacobians, bool on_tangents) const;
+  void WriteJacobians(const States& states, const Linearization& lin, double** jacobians, bool on_tangents) const;
 
   ImuPreintegration preintegration_;
   Eigen::Vector3d g_w_;

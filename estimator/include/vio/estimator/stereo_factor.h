@@ -19,11 +19,12 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "vio/estimator/tangent_cost_function.h"
 #include "vio/estimator/types.h"
 
 namespace vio {
 
-class StereoFactor final : public ceres::SizedCostFunction<3, 7, 3> {
+class StereoFactor final : public ceres::SizedCostFunction<3, 7, 3>, public TangentCostFunction {
  public:
   /// Smallest depth [m] in the left camera that Evaluate accepts.
   static constexpr double kMinDepth = 1e-3;
@@ -42,8 +43,13 @@ class StereoFactor final : public ceres::SizedCostFunction<3, 7, 3> {
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
+  bool EvaluateOnTangents(double const* const* parameters, double* residuals,
+                          double** jacobians) const override;
 
  private:
+  bool EvaluateImpl(double const* const* parameters, double* residuals, double** jacobians,
+                    bool on_tangents) const;
+
   Eigen::Vector3d z_px_;
   RectifiedStereo stereo_;
   double inverse_sigma_;
