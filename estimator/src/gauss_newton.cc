@@ -173,32 +173,34 @@ struct GaussNewtonSolver::System {
   Eigen::MatrixXd UL;
 
   System(ceres::Problem* p, GaussNewtonLayout l) : problem(p), layout(std::move(l)) {
-    // A lookup from block to column only: no order depends on the addresses.
-    std::unordered_map<const double*, std::pair<int, int>> index;
+    // A lookup from variable block to its slot fields only: no order depends on the addresses.
+    std::unordered_map<const double*, Slot> index;
     for (size_t k = 0; k < layout.dense.size(); ++k) {
       dense.push_back({dense_dim, problem->ParameterBlockTangentSize(layout.dense[k])});
       dense_dim += dense.back().size;
-      index[layout.dense[k]] = {static_cast<int>(k), -1};
+      index[layout.dense[k]].dense = static_cast<int>(k);
     }
     int col = dense_dim;
     eliminated.resize(layout.eliminated.size());
     for (size_t k = 0; k < layout.eliminated.size(); ++k) {
       eliminated[k].columns = {col, problem->ParameterBlockTangentSize(layout.eliminated[k])};
       col += eliminated[k].columns.size;
-      index[layout.eliminated[k]] = {-1, static_cast<int>(k)};
+      index[layout.eliminated[k]].eliminated = static_cast<int>(k);
     }
     for (const std::vector<double*>* blocks : {&layout.dense, &layout.eliminated}) {
       for (const double* block : *blocks) {
+        Slot& slot = index[block];
+        slot.tangent = slot.dense >= 0 ? dense[slot.dense].size : eliminated[slot.eliminated].columns.size;
+        slot.ambient = problem->ParameterBlockSize(block);
         if (const ceres::Manifold* manifold = problem->GetManifold(block)) manifold_blocks.emplace_back(manifold, block);
       }
     }
     plus_jacobians.resize(manifold_blocks.size());
-    std::unordered_map<const double*, const RowMajorMatrix*> plus_jacobian_of;
-    for (size_t k = 0; k < manifold_blocks.size(); ++k) plus_jacobian_of[manifold_blocks[k].second] = &plus_jacobians[k];
+    for (size_t k = 0; k < manifold_blocks.size(); ++k) index[manifold_blocks[k].second].plus_jacobian = &plus_jacobians[k];
     size_t scratch = 0;
     size_t ambient_scratch = 0;
     for (ceres::ResidualBlockId id : layout.residuals) {
-      const auto [tangent_size, ambient_size] = AddResidual(id, index, plus_jacobian_of);
+      const auto [tangent_size, ambient_size] = AddResidual(id, index);
       scratch = std::max(scratch, tangent_size);
       ambient_scratch = std::max(ambient_scratch, ambient_size);
     }
@@ -249,9 +251,7 @@ struct GaussNewtonSolver::System {
 
   // The residual's slots; returns the scratch its tangent Jacobians and its
   // ambient ones (blocks with a manifold) need.
-  std::pair<size_t, size_t> AddResidual(ceres::ResidualBlockId id,
-                                        const std::unordered_map<const double*, std::pair<int, int>>& index,
-                                        const std::unordered_map<const double*, const RowMajorMatrix*>& plus_jacobian_of) {
+  std::pair<size_t, size_t> AddResidual(ceres::ResidualBlockId id, const std::unordered_map<const double*, Slot>& index) {
     Residual& residual = residuals.emplace_back();
     residual.id = id;
     const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(id);
@@ -263,13 +263,9 @@ struct GaussNewtonSolver::System {
     int jacobian = 0;
     int ambient = 0;
     for (const double* value : residual.values) {
-      Slot slot;
-      slot.tangent = problem->ParameterBlockTangentSize(value);
-      slot.ambient = problem->ParameterBlockSize(value);
-      if (const auto it = plus_jacobian_of.find(value); it != plus_jacobian_of.end()) slot.plus_jacobian = it->second;
-      if (const auto it = index.find(value); it != index.end()) {
-        std::tie(slot.dense, slot.eliminated) = it->second;
-      }
+      // A block outside the layout is held constant: no Jacobian, no columns.
+      const auto it = index.find(value);
+      Slot slot = it != index.end() ? it->second : Slot{};
       if (slot.eliminated >= 0) {
         CHECK(residual.eliminated < 0 || residual.eliminated == slot.eliminated)
             << "a residual couples two eliminated blocks";

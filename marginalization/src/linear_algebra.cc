@@ -215,26 +215,44 @@ struct PivotedCholesky {
   std::vector<int> order;
 };
 
+/// Blocked as LAPACK's dpstrf: within a panel of kPanel columns each column is
+/// formed left-looking from the panel's earlier columns, pivoting on `d`, the
+/// remaining Schur complement's diagonal kept up to date; the trailing matrix
+/// takes the panel's update as one rank-kPanel product after the panel.
 PivotedCholesky PivotedCholeskyOf(const Eigen::MatrixXd& H_symmetric, double cutoff) {
+  constexpr Eigen::Index kPanel = 32;
   const Eigen::Index n = H_symmetric.rows();
-  Eigen::MatrixXd A = H_symmetric;
+  Eigen::MatrixXd A = H_symmetric;  // lower triangle: L's columns so far, and the trailing matrix
+  Eigen::VectorXd d = A.diagonal();
   std::vector<int> order(static_cast<size_t>(n));
   for (Eigen::Index i = 0; i < n; ++i) order[i] = static_cast<int>(i);
   Eigen::Index rank = 0;
-  for (; rank < n; ++rank) {
-    const Eigen::Index k = rank;
-    Eigen::Index j = 0;
-    if (!(A.diagonal().tail(n - k).maxCoeff(&j) > cutoff)) break;
-    j += k;
-    if (j != k) {
-      SymmetricSwap(A, k, j);
-      std::swap(order[k], order[j]);
+  bool done = false;
+  for (Eigen::Index panel = 0; panel < n && !done; panel += kPanel) {
+    const Eigen::Index end = std::min(n, panel + kPanel);
+    for (Eigen::Index k = panel; k < end; ++k, ++rank) {
+      Eigen::Index j = 0;
+      if (!(d.tail(n - k).maxCoeff(&j) > cutoff)) {
+        done = true;
+        break;
+      }
+      j += k;
+      if (j != k) {
+        SymmetricSwap(A, k, j);
+        std::swap(d(k), d(j));
+        std::swap(order[k], order[j]);
+      }
+      const double pivot = std::sqrt(d(k));
+      auto column = A.col(k).tail(n - k - 1);
+      column.noalias() -= A.block(k + 1, panel, n - k - 1, k - panel) * A.row(k).segment(panel, k - panel).transpose();
+      column /= pivot;
+      A(k, k) = pivot;
+      d.tail(n - k - 1) -= column.cwiseAbs2();
     }
-    const double pivot = std::sqrt(A(k, k));
-    A(k, k) = pivot;
-    A.col(k).tail(n - k - 1) /= pivot;
-    for (Eigen::Index c = k + 1; c < n; ++c) {  // the lower triangle of the trailing Schur complement
-      A.col(c).tail(n - c) -= A(c, k) * A.col(k).tail(n - c);
+    const Eigen::Index width = rank - panel;
+    if (!done && end < n) {
+      A.bottomRightCorner(n - end, n - end).selfadjointView<Eigen::Lower>().rankUpdate(
+          A.block(end, panel, n - end, width), -1.0);
     }
   }
   PivotedCholesky factor{A.leftCols(rank), std::move(order)};
