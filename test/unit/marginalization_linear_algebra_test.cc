@@ -140,10 +140,14 @@ TEST(PseudoInverse, ThreeByThreeBlocksAtEveryRank) {
     ASSERT_EQ(H_pinv.rows(), 3);
     EXPECT_LT(RelativeError(H * H_pinv * H, H), 1e-10) << "rank " << rank;
     EXPECT_LT(RelativeError(H_pinv * H * H_pinv, H_pinv), 1e-10) << "rank " << rank;
-    if (rank == 3) EXPECT_LT(RelativeError(H_pinv, H.inverse()), 1e-10);
+    if (rank == 3) {
+      EXPECT_LT(RelativeError(H_pinv, H.inverse()), 1e-10);
+    }
     const Eigen::FullPivLU<Eigen::MatrixXd> lu(J);
     const Eigen::MatrixXd null_space = lu.kernel();
-    if (rank < 3) EXPECT_LT((H_pinv * null_space).norm(), 1e-10 * H_pinv.norm()) << "rank " << rank;
+    if (rank < 3) {
+      EXPECT_LT((H_pinv * null_space).norm(), 1e-10 * H_pinv.norm()) << "rank " << rank;
+    }
   }
 }
 
