@@ -4,9 +4,12 @@
 # V2_01, each a `vio run` on one core (taskset -c 0 when available) under
 # /usr/bin/time -v. Prints one table.
 #
-# usage: tools/bench.sh [--quick] [--rows=ROW,...] [--cache=DIR] [--rendered_s=S]
+# usage: tools/bench.sh [--quick] [--rows=ROW,...] [--repeat=N] [--cache=DIR] [--rendered_s=S]
 #   --quick       rows swf10, msckf10 and klt only
 #   --rows        a subset of: swf5 swf10 swf30 swf50 msckf10 ekf keyframe brisk klt
+#   --repeat      runs per row (default 1): ms/frame and front_ms are then the
+#                 medians and ms_range the fastest and slowest run (a shared
+#                 machine's speed drifts by 15-35 % between hours)
 #   --cache       where the generated datasets and the runs go (default
 #                 ${VIO_BENCH_CACHE:-/tmp/vio_bench}); datasets are reused when present
 #   --rendered_s  seconds of V2_01 rendered for the front-end rows (default 20)
@@ -19,16 +22,19 @@ euroc="${EUROC:-$root/../shared/data/euroc}"
 cache="${VIO_BENCH_CACHE:-/tmp/vio_bench}"
 rows="swf5,swf10,swf30,swf50,msckf10,ekf,keyframe,brisk,klt"
 rendered_s=20
+repeat=1
 for arg in "$@"; do
   case "$arg" in
     --quick) rows="swf10,msckf10,klt" ;;
     --rows=*) rows="${arg#--rows=}" ;;
     --cache=*) cache="${arg#--cache=}" ;;
     --rendered_s=*) rendered_s="${arg#--rendered_s=}" ;;
-    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+    --repeat=*) repeat="${arg#--repeat=}" ;;
+    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
     *) echo "bench.sh: unknown argument '$arg' (see --help)" >&2; exit 2 ;;
   esac
 done
+case "$repeat" in ''|*[!0-9]*|0) echo "bench.sh: --repeat must be a positive integer, got '$repeat'" >&2; exit 2 ;; esac
 source_dir="$euroc/V2_01_easy"
 [ -d "$source_dir/mav0" ] || { echo "bench.sh: $source_dir/mav0 not found (set EUROC)" >&2; exit 1; }
 mkdir -p "$cache"
@@ -68,31 +74,43 @@ if [ "$needs_images" -eq 1 ] && [ ! -d "$rendered/mav0/cam1/data" ]; then
   "$vio" simulate --from="$cache/V2_01_first_${rendered_s}s" --camera=images --output_dir="$rendered" >/dev/null 2>&1
 fi
 
-# One row: name, dataset, description, then the run's flags.
+# One row: name, dataset, description, then the run's flags; `repeat` runs,
+# each in its own folder, summarized by their medians.
 run_row() {
   local name="$1" dataset="$2" what="$3"; shift 3
   local out="$cache/runs/$name"
   rm -rf "$out"; mkdir -p "$out"
-  if ! "${pin[@]}" /usr/bin/time -v -o "$out/time.txt" "$vio" run --dataset="$dataset" --output_dir="$out" \
-      --config="$root/config/euroc_stereo.yaml" "$@" >"$out/log.txt" 2>&1; then
-    printf '%-10s %-44s failed (%s)\n' "$name" "$what" "$out/log.txt"; return
-  fi
-  python3 - "$out" "$name" "$what" <<'EOF'
-import json, re, sys
-out, name, what = sys.argv[1:4]
-s = json.load(open(out + "/summary.json"))
-rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", open(out + "/time.txt").read()).group(1))
+  local k
+  for ((k = 1; k <= repeat; ++k)); do
+    local run="$out/run_$k"
+    mkdir -p "$run"
+    if ! "${pin[@]}" /usr/bin/time -v -o "$run/time.txt" "$vio" run --dataset="$dataset" --output_dir="$run" \
+        --config="$root/config/euroc_stereo.yaml" "$@" >"$run/log.txt" 2>&1; then
+      printf '%-10s %-44s failed (%s)\n' "$name" "$what" "$run/log.txt"; return
+    fi
+  done
+  python3 - "$out" "$name" "$what" "$repeat" <<'EOF'
+import json, re, statistics, sys
+out, name, what, repeat = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
+runs = [f"{out}/run_{k}" for k in range(1, repeat + 1)]
+summaries = [json.load(open(run + "/summary.json")) for run in runs]
+rss_kb = max(int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", open(run + "/time.txt").read()).group(1))
+             for run in runs)
+ms = [t["ms_per_frame"] for t in summaries]
+s = summaries[0]
 ate = s.get("evaluation", {}).get("ate", {}).get("rmse_m")
-front = s.get("frontend", {}).get("stage_ms", {}).get("frontend")
-front = f"{front:8.1f}" if isinstance(front, (int, float)) else f"{'-':>8}"
-print(f"{name:<10} {what:<44} {s['frames_estimated']:>6} {s['ms_per_frame']:8.2f} {front} "
-      f"{rss_kb / 1024:8.1f} {s.get('peak_memory_mb', 0):8.1f} "
+fronts = [t.get("frontend", {}).get("stage_ms", {}).get("frontend") for t in summaries]
+front = f"{statistics.median(fronts):8.1f}" if all(isinstance(f, (int, float)) for f in fronts) else f"{'-':>8}"
+ms_range = f"{min(ms):.2f}-{max(ms):.2f}"
+print(f"{name:<10} {what:<44} {s['frames_estimated']:>6} {statistics.median(ms):8.2f} {ms_range:>13} {front} "
+      f"{rss_kb / 1024:8.1f} {max(t.get('peak_memory_mb', 0) for t in summaries):8.1f} "
       + (f"{ate:8.4f}" if ate is not None else f"{'-':>8}") + f" {s['status']}")
 EOF
 }
 
 echo "bench: one core (${pin[*]:-no taskset}), Release vio, config/euroc_stereo.yaml"
-printf '%-10s %-44s %6s %8s %8s %8s %8s %8s %s\n' row what frames ms/frame front_ms rss_MB run_MB ate_m status
+printf '%-10s %-44s %6s %8s %13s %8s %8s %8s %8s %s\n' row what frames ms/frame ms_range front_ms rss_MB run_MB \
+  ate_m status
 IFS=, read -r -a selected <<< "$rows"
 for row in "${selected[@]}"; do
   case "$row" in
@@ -110,5 +128,7 @@ for row in "${selected[@]}"; do
     *) echo "bench.sh: unknown row '$row'" >&2; exit 2 ;;
   esac
 done
-echo "ms/frame: vio run's processing time per estimated frame; front_ms: the front end's share (image rows);"
-echo "rss_MB: peak RSS from /usr/bin/time -v; run_MB: the peak vio run reports (getrusage); runs in $cache/runs"
+echo "ms/frame: vio run's processing time per estimated frame, the median of $repeat run(s) (ms_range: fastest-slowest);"
+echo "front_ms: the front end's share (image rows);"
+echo "rss_MB: peak RSS from /usr/bin/time -v; run_MB: the peak vio run reports (getrusage); both the largest over the"
+echo "runs, in $cache/runs/ROW/run_K"
