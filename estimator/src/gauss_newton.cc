@@ -78,20 +78,40 @@ struct PendingUpdate {
   int block = 0;  ///< the eliminated block holding U
 };
 
-/// tangent = ambient * plus_jacobian on fixed-size row-major blocks.
-template <int Rows, int Ambient, int Tangent>
-void ToTangent(const double* ambient, const double* plus_jacobian, double* tangent) {
-  Eigen::Map<Eigen::Matrix<double, Rows, Tangent, Eigen::RowMajor>>(tangent).noalias() =
-      Eigen::Map<const Eigen::Matrix<double, Rows, Ambient, Eigen::RowMajor>>(ambient) *
-      Eigen::Map<const Eigen::Matrix<double, Ambient, Tangent, Eigen::RowMajor>>(plus_jacobian);
-}
-
 /// Ceres' Corrector on one row-major Jacobian: J <- sqrt_rho1 (J - alpha_sq_norm r (r^T J)).
 template <int Rows, typename Residuals>
 void CorrectJacobian(const Residuals& res, double alpha_sq_norm, double sqrt_rho1, int tangent, double* jacobian) {
   Eigen::Map<Eigen::Matrix<double, Rows, Eigen::Dynamic, Eigen::RowMajor>> J(jacobian, res.size(), tangent);
   if (alpha_sq_norm != 0.0) J -= alpha_sq_norm * res * (res.transpose() * J);
   J *= sqrt_rho1;
+}
+
+/// The robust loss applied as Ceres applies it (its Corrector, after Triggs et
+/// al.): J <- sqrt(rho') (J - alpha r r^T J / |r|^2) for every (Jacobian,
+/// tangent size) in `jacobians`, then r <- sqrt(rho') r / (1 - alpha); returns
+/// the cost 0.5 rho(|r|^2).
+double ApplyLoss(const ceres::LossFunction& loss, Eigen::Map<Eigen::VectorXd> res,
+                 const std::vector<std::pair<double*, int>>& jacobians) {
+  const double squared_norm = res.squaredNorm();
+  double rho[3];
+  loss.Evaluate(squared_norm, rho);
+  const double sqrt_rho1 = std::sqrt(rho[1]);
+  double residual_scaling = sqrt_rho1;
+  double alpha_sq_norm = 0.0;
+  if (squared_norm != 0.0 && rho[2] > 0.0) {
+    const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * squared_norm * rho[2] / rho[1]);
+    residual_scaling = sqrt_rho1 / (1.0 - alpha);
+    alpha_sq_norm = alpha / squared_norm;
+  }
+  for (const auto& [jacobian, tangent] : jacobians) {
+    if (res.size() == 3) {  // stereo residuals, on fixed-size products
+      CorrectJacobian<3>(Eigen::Map<const Eigen::Vector3d>(res.data()), alpha_sq_norm, sqrt_rho1, tangent, jacobian);
+    } else {
+      CorrectJacobian<Eigen::Dynamic>(res, alpha_sq_norm, sqrt_rho1, tangent, jacobian);
+    }
+  }
+  res *= residual_scaling;
+  return 0.5 * rho[0];
 }
 
 void ApplyStep(ceres::Problem* problem, const std::vector<double*>& blocks, const Eigen::VectorXd& dx,
@@ -159,6 +179,7 @@ struct GaussNewtonSolver::System {
   std::vector<double> jacobians;
   std::vector<double> ambient_jacobians;  ///< what the cost function writes for blocks with a manifold
   std::vector<double*> jacobian_pointers;
+  std::vector<std::pair<double*, int>> tangent_jacobians;  ///< one residual's (Jacobian, tangent size)
   /// PlusJacobian at the current values of every variable block with a
   /// manifold (dense, then eliminated blocks), refreshed once per assembly.
   std::vector<RowMajorMatrix> plus_jacobians;
@@ -348,9 +369,8 @@ struct GaussNewtonSolver::System {
   // What Problem::EvaluateResidualBlock(apply_loss_function = true) gives,
   // without its per-call bookkeeping: the cost 0.5 rho(|r|^2), the residual
   // and the tangent Jacobians (from a TangentCostFunction directly, else
-  // ambient ones times the step's cached PlusJacobian) corrected for the loss as Ceres' Corrector does (Triggs et
-  // al.: J <- sqrt(rho') (J - alpha r r^T J / |r|^2), r <- sqrt(rho') r / (1 - alpha)).
-  // False when the cost function fails or gives a non-finite value.
+  // ambient ones times the step's cached PlusJacobian), corrected for the loss
+  // (ApplyLoss). False when the cost function fails or gives a non-finite value.
   bool EvaluateOnTangents(const Residual& residual, double* cost) {
     const int rows = residual.rows;
     const bool on_tangents = residual.on_tangents != nullptr;  // no ambient round trip
@@ -368,49 +388,20 @@ struct GaussNewtonSolver::System {
     const bool evaluated =
         on_tangents ? residual.on_tangents->EvaluateOnTangents(residual.values.data(), r.data(), jacobian_pointers.data())
                     : residual.cost->Evaluate(residual.values.data(), r.data(), jacobian_pointers.data());
-    if (!evaluated) return false;
     Eigen::Map<Eigen::VectorXd> res(r.data(), rows);
-    if (!res.allFinite()) return false;
+    if (!evaluated || !res.allFinite()) return false;
+    tangent_jacobians.clear();
     for (size_t k = 0; k < residual.slots.size(); ++k) {
       const Slot& slot = residual.slots[k];
       if (!slot.variable()) continue;
-      double* tangent = jacobians.data() + slot.jacobian;
+      Eigen::Map<RowMajorMatrix> tangent(jacobians.data() + slot.jacobian, rows, slot.tangent);
       if (slot.plus_jacobian != nullptr && !on_tangents) {
-        if (rows == 3 && slot.ambient == 7 && slot.tangent == 6) {  // a stereo residual on a pose
-          ToTangent<3, 7, 6>(jacobian_pointers[k], slot.plus_jacobian->data(), tangent);
-        } else {
-          Eigen::Map<RowMajorMatrix>(tangent, rows, slot.tangent).noalias() =
-              Eigen::Map<const RowMajorMatrix>(jacobian_pointers[k], rows, slot.ambient) * *slot.plus_jacobian;
-        }
+        tangent.noalias() = Eigen::Map<const RowMajorMatrix>(jacobian_pointers[k], rows, slot.ambient) * *slot.plus_jacobian;
       }
-      if (!Eigen::Map<const Eigen::VectorXd>(tangent, rows * slot.tangent).allFinite()) return false;
+      if (!tangent.allFinite()) return false;
+      tangent_jacobians.emplace_back(tangent.data(), slot.tangent);
     }
-    const double squared_norm = res.squaredNorm();
-    if (residual.loss == nullptr) {
-      *cost = 0.5 * squared_norm;
-      return true;
-    }
-    double rho[3];
-    residual.loss->Evaluate(squared_norm, rho);
-    *cost = 0.5 * rho[0];
-    const double sqrt_rho1 = std::sqrt(rho[1]);
-    double residual_scaling = sqrt_rho1;
-    double alpha_sq_norm = 0.0;
-    if (squared_norm != 0.0 && rho[2] > 0.0) {
-      const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * squared_norm * rho[2] / rho[1]);
-      residual_scaling = sqrt_rho1 / (1.0 - alpha);
-      alpha_sq_norm = alpha / squared_norm;
-    }
-    for (const Slot& slot : residual.slots) {
-      if (!slot.variable()) continue;
-      double* J = jacobians.data() + slot.jacobian;
-      if (rows == 3) {
-        CorrectJacobian<3>(Eigen::Map<const Eigen::Vector3d>(r.data()), alpha_sq_norm, sqrt_rho1, slot.tangent, J);
-      } else {
-        CorrectJacobian<Eigen::Dynamic>(res, alpha_sq_norm, sqrt_rho1, slot.tangent, J);
-      }
-    }
-    res *= residual_scaling;
+    *cost = residual.loss == nullptr ? 0.5 * res.squaredNorm() : ApplyLoss(*residual.loss, res, tangent_jacobians);
     return std::isfinite(*cost);
   }
 
@@ -515,19 +506,7 @@ struct GaussNewtonSolver::System {
       int rows = 0;
       for (const int d : block.coupled) rows += dense[d].size;
       const bool contiguous = span <= 2 * rows;
-      if (contiguous) {
-        U.setZero(span, block.columns.size);
-        for (size_t p = 0; p < block.coupled.size(); ++p) {
-          U.middleRows(dense[block.coupled[p]].offset - first, block.W[p].rows()) = block.W[p];
-        }
-      } else {
-        U.resize(rows, block.columns.size);
-        rows = 0;
-        for (size_t p = 0; p < block.coupled.size(); ++p) {
-          U.middleRows(rows, block.W[p].rows()) = block.W[p];
-          rows += static_cast<int>(block.W[p].rows());
-        }
-      }
+      StackCouplings(block, contiguous ? first : -1, contiguous ? span : rows);
       if (U.cols() == 3) {  // a landmark: the 3x3 factor on fixed-size, coefficient by coefficient
         const Eigen::Matrix3d L = factor.matrixL();
         UL.noalias() = U.lazyProduct(L);
@@ -540,25 +519,44 @@ struct GaussNewtonSolver::System {
         b.segment(first, span).noalias() -= U * c;
         block.U = U;
         pending.push_back({first, span, static_cast<int>(k)});
-        continue;
-      }
-      rows = 0;
-      for (size_t p = 0; p < block.coupled.size(); ++p) {
-        const Columns& a = dense[block.coupled[p]];
-        b.segment(a.offset, a.size).noalias() -= U.middleRows(rows, a.size) * c;
-        rows += a.size;
-      }
-      UUt.setZero(rows, rows);
-      UUt.selfadjointView<Eigen::Upper>().rankUpdate(U);
-      for (size_t p = 0, rp = 0; p < block.coupled.size(); rp += dense[block.coupled[p]].size, ++p) {
-        const Columns& a = dense[block.coupled[p]];
-        for (size_t q = p, rq = rp; q < block.coupled.size(); rq += dense[block.coupled[q]].size, ++q) {
-          const Columns& c2 = dense[block.coupled[q]];
-          H.block(a.offset, c2.offset, a.size, c2.size) -= UUt.block(rp, rq, a.size, c2.size);
-        }
+      } else {
+        SubtractPackedUpdate(block, c);
       }
     }
     SubtractPendingUpdates();
+  }
+
+  // U = the block's couplings W stacked: at their columns' offsets from
+  // `first` over `rows` rows (zero rows in the gaps), or packed one after the
+  // other when `first` is -1.
+  void StackCouplings(const EliminatedBlock& block, int first, int rows) {
+    if (first >= 0) {
+      U.setZero(rows, block.columns.size);
+    } else {
+      U.resize(rows, block.columns.size);
+    }
+    for (size_t p = 0, packed = 0; p < block.coupled.size(); packed += block.W[p].rows(), ++p) {
+      const Eigen::Index row = first >= 0 ? dense[block.coupled[p]].offset - first : static_cast<Eigen::Index>(packed);
+      U.middleRows(row, block.W[p].rows()) = block.W[p];
+    }
+  }
+
+  // b -= U c and H -= U U^T block pair by block pair, U packed (StackCouplings).
+  void SubtractPackedUpdate(const EliminatedBlock& block, const Eigen::VectorXd& c) {
+    const Eigen::Index rows = U.rows();
+    for (size_t p = 0, rp = 0; p < block.coupled.size(); rp += dense[block.coupled[p]].size, ++p) {
+      const Columns& a = dense[block.coupled[p]];
+      b.segment(a.offset, a.size).noalias() -= U.middleRows(rp, a.size) * c;
+    }
+    UUt.setZero(rows, rows);
+    UUt.selfadjointView<Eigen::Upper>().rankUpdate(U);
+    for (size_t p = 0, rp = 0; p < block.coupled.size(); rp += dense[block.coupled[p]].size, ++p) {
+      const Columns& a = dense[block.coupled[p]];
+      for (size_t q = p, rq = rp; q < block.coupled.size(); rq += dense[block.coupled[q]].size, ++q) {
+        const Columns& c2 = dense[block.coupled[q]];
+        H.block(a.offset, c2.offset, a.size, c2.size) -= UUt.block(rp, rq, a.size, c2.size);
+      }
+    }
   }
 
   // The contiguous updates H -= U U^T grouped by the rows they touch: one

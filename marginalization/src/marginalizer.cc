@@ -140,51 +140,19 @@ int TangentDim(const ceres::Problem& problem, const std::vector<double*>& blocks
   return dim;
 }
 
-/// H = J^T J, b = J^T r of a CRS Jacobian. Sparse rows (a factor touching a
-/// few blocks) add their outer products entry by entry; dense rows (an
-/// earlier prior) are gathered, on the columns they touch only, into one dense
-/// matrix whose product is left to Eigen's blocked kernels. (The prior spans
-/// the states; the blanket of a marginalized state also holds the landmarks it
-/// observes, columns where the prior is zero.)
+/// H = J^T J, b = J^T r of a CRS Jacobian, row by row: the rows are factors
+/// touching a few blocks (an earlier prior, the one dense factor, comes from
+/// its information instead: AddPrior).
 NormalEquations NormalEquationsOf(const ceres::CRSMatrix& J, const std::vector<double>& r) {
-  constexpr int kDenseRow = 64;  // nonzeros from which a row counts as dense
   const int n = J.num_cols;
   NormalEquations eq{Eigen::MatrixXd::Zero(n, n), Eigen::VectorXd::Zero(n)};
-  std::vector<int> dense_rows;
   for (int i = 0; i < J.num_rows; ++i) {
     const int begin = J.rows[i], end = J.rows[i + 1];
-    if (end - begin > kDenseRow) {
-      dense_rows.push_back(i);
-      continue;
-    }
     for (int a = begin; a < end; ++a) {
       eq.b[J.cols[a]] += J.values[a] * r[i];
       for (int c = begin; c < end; ++c) eq.H(J.cols[a], J.cols[c]) += J.values[a] * J.values[c];
     }
   }
-  if (dense_rows.empty()) return eq;
-  std::vector<int> compact_of(n, -1);
-  std::vector<int> columns;  // the columns some dense row touches, ascending
-  for (const int i : dense_rows) {
-    for (int a = J.rows[i]; a < J.rows[i + 1]; ++a) compact_of[J.cols[a]] = 0;
-  }
-  for (int c = 0; c < n; ++c) {
-    if (compact_of[c] < 0) continue;
-    compact_of[c] = static_cast<int>(columns.size());
-    columns.push_back(c);
-  }
-  Eigen::MatrixXd Jd = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(dense_rows.size()),
-                                             static_cast<Eigen::Index>(columns.size()));
-  Eigen::VectorXd rd(Jd.rows());
-  for (Eigen::Index k = 0; k < Jd.rows(); ++k) {
-    const int i = dense_rows[k];
-    for (int a = J.rows[i]; a < J.rows[i + 1]; ++a) Jd(k, compact_of[J.cols[a]]) = J.values[a];
-    rd[k] = r[i];
-  }
-  const Eigen::MatrixXd Hd = Jd.transpose() * Jd;
-  const Eigen::VectorXd bd = Jd.transpose() * rd;
-  eq.H(columns, columns) += Hd;
-  eq.b(columns) += bd;
   return eq;
 }
 

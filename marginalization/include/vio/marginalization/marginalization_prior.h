@@ -79,11 +79,6 @@ class MarginalizationPrior final : public ceres::CostFunction {
   const Eigen::MatrixXd& information() const { return information_; }
   /// Jp^T r0, computed once.
   const Eigen::VectorXd& information_vector() const { return information_vector_; }
-  /// The stacked deltas [x_i ⊟ x0_i] at `parameters`, and per block T_i (tangent x
-  /// tangent, see above): the tangent Jacobian of r is Jp_i T_i, so a solver can
-  /// assemble the normal equations from information() without forming Jp T.
-  bool TangentJacobians(double const* const* parameters, Eigen::VectorXd* delta,
-                        std::vector<Eigen::MatrixXd>* T) const;
   /// The prior's normal equations on the stacked tangent spaces at
   /// `parameters`, from information(): H = T^T (Jp^T Jp) T, g = T^T (Jp^T r0 +
   /// Jp^T Jp delta) (= J^T r), and cost = 0.5 |r|^2. O(n^2), no Jp T formed.
@@ -98,6 +93,11 @@ class MarginalizationPrior final : public ceres::CostFunction {
   MarginalizationPrior(std::vector<Block> blocks, Eigen::MatrixXd sqrt_information,
                        Eigen::VectorXd residual_at_x0, Eigen::MatrixXd information);
 
+  /// The stacked deltas [x_i ⊟ x0_i] at `parameters`, and per block T_i (tangent x
+  /// tangent, see above): the tangent Jacobian of r is Jp_i T_i, used by
+  /// TangentNormalEquations.
+  bool TangentJacobians(double const* const* parameters, Eigen::VectorXd* delta,
+                        std::vector<Eigen::MatrixXd>* T) const;
   /// delta_i = x_i ⊟ x0_i written into the tangent_size(i) values at `delta`.
   bool LocalCoordinates(int i, const double* x, double* delta) const;
   /// T_i(x) = d (x ⊞ d) ⊟ x0_i / d d at d = 0 (tangent x tangent).
