@@ -7,7 +7,7 @@
 # usage: tools/bench.sh [--quick] [--rows=ROW,...] [--repeat=N] [--cache=DIR] [--rendered_s=S]
 #   --quick       rows swf10, msckf10 and klt only
 #   --rows        a subset of: swf5 swf10 swf30 swf50 msckf10 ekf keyframe brisk klt
-#   --repeat      runs per row (default 1): ms/frame and front_ms are then the
+#   --repeat      runs per row (default 1): ms/frame and the stage times are then the
 #                 medians and ms_range the fastest and slowest run (a shared
 #                 machine's speed drifts by 15-35 % between hours)
 #   --cache       where the generated datasets and the runs go (default
@@ -67,7 +67,7 @@ if [ ! -f "$hybrid/mav0/features0/data.csv" ]; then
 fi
 needs_images=0
 case ",$rows," in *,brisk,*|*,klt,*) needs_images=1 ;; esac
-rendered="$cache/rendered_V2_01_${rendered_s}s"
+rendered="$cache/rendered_V2_01_${rendered_s}s_stored"  # stored PNGs (vio simulate since its png_compression 0 default)
 if [ "$needs_images" -eq 1 ] && [ ! -d "$rendered/mav0/cam1/data" ]; then
   echo "bench: rendering $rendered (first ${rendered_s} s of V2_01, images)"
   trim_euroc "$source_dir" "$cache/V2_01_first_${rendered_s}s" "$rendered_s"
@@ -99,18 +99,23 @@ rss_kb = max(int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", open(
 ms = [t["ms_per_frame"] for t in summaries]
 s = summaries[0]
 ate = s.get("evaluation", {}).get("ate", {}).get("rmse_m")
-fronts = [t.get("frontend", {}).get("stage_ms", {}).get("frontend") for t in summaries]
-front = f"{statistics.median(fronts):8.1f}" if all(isinstance(f, (int, float)) for f in fronts) else f"{'-':>8}"
+def median_of(values, width):
+    ok = all(isinstance(v, (int, float)) for v in values)
+    return f"{statistics.median(values):{width}.1f}" if ok else f"{'-':>{width}}"
+front = median_of([t.get("frontend", {}).get("stage_ms", {}).get("frontend") for t in summaries], 8)
+front_cpu = median_of([t.get("frontend", {}).get("cpu_ms", {}).get("frontend") for t in summaries], 9)
+decode_cpu = median_of([t.get("frontend", {}).get("cpu_ms", {}).get("decode") for t in summaries], 10)
 ms_range = f"{min(ms):.2f}-{max(ms):.2f}"
 print(f"{name:<10} {what:<44} {s['frames_estimated']:>6} {statistics.median(ms):8.2f} {ms_range:>13} {front} "
+      f"{front_cpu} {decode_cpu} "
       f"{rss_kb / 1024:8.1f} {max(t.get('peak_memory_mb', 0) for t in summaries):8.1f} "
       + (f"{ate:8.4f}" if ate is not None else f"{'-':>8}") + f" {s['status']}")
 EOF
 }
 
 echo "bench: one core (${pin[*]:-no taskset}), Release vio, config/euroc_stereo.yaml"
-printf '%-10s %-44s %6s %8s %13s %8s %8s %8s %8s %s\n' row what frames ms/frame ms_range front_ms rss_MB run_MB \
-  ate_m status
+printf '%-10s %-44s %6s %8s %13s %8s %9s %10s %8s %8s %8s %s\n' row what frames ms/frame ms_range front_ms \
+  front_cpu decode_cpu rss_MB run_MB ate_m status
 IFS=, read -r -a selected <<< "$rows"
 for row in "${selected[@]}"; do
   case "$row" in
@@ -129,6 +134,8 @@ for row in "${selected[@]}"; do
   esac
 done
 echo "ms/frame: vio run's processing time per estimated frame, the median of $repeat run(s) (ms_range: fastest-slowest);"
-echo "front_ms: the front end's share (image rows);"
+echo "front_ms: the front end's share (image rows, wall clock: on one core it absorbs the read-ahead's decoding);"
+echo "front_cpu, decode_cpu: CPU time of the front end's thread and of the image reading and decoding (read-ahead"
+echo "thread), per frame;"
 echo "rss_MB: peak RSS from /usr/bin/time -v; run_MB: the peak vio run reports (getrusage); both the largest over the"
 echo "runs, in $cache/runs/ROW/run_K"

@@ -9,6 +9,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <time.h>
+
 #include <glog/logging.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -34,6 +36,14 @@ std::string Number(double x) {
   os.precision(6);
   os << x;
   return os.str();
+}
+
+// CPU time of the calling thread [ms]: what a stage costs itself, whatever
+// else shares the core (wall-clock stage times absorb the other threads).
+double ThreadCpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
 }
 
 class ImageFrameSource final : public FrameSource {
@@ -64,7 +74,9 @@ class ImageFrameSource final : public FrameSource {
     frontend::FramePrior prior;
     prior.T_w_b = estimator.PredictBodyPose(pair.t_ns);
     prior.landmarks = &estimator.window().landmarks();
+    const double cpu_start_ms = ThreadCpuMs();
     StereoFrame frame = frontend_->Process(pair.t_ns, left, right, prior);
+    frontend_cpu_ms_ += ThreadCpuMs() - cpu_start_ms;
     if (!debug_dir_.empty()) WriteDebugImage(pair.t_ns, left, right);
     return frame;
   }
@@ -91,19 +103,28 @@ class ImageFrameSource final : public FrameSource {
     if (unpaired_ > 0) LOG(WARNING) << mav0_ << ": " << unpaired_ << " cam0 frames have no cam1 image; skipped";
   }
 
+  struct LoadedPair {
+    cv::Mat left, right;
+    double cpu_ms = 0;  ///< CPU time the reading and decoding took on its thread
+  };
+
   // Pair k, decoded by the read-ahead started for it (else now); starts the
   // read-ahead of pair k + 1 on another thread, so decoding overlaps tracking.
   std::pair<cv::Mat, cv::Mat> TakeImages(size_t k) {
-    std::pair<cv::Mat, cv::Mat> images = next_.valid() && next_k_ == k ? next_.get() : LoadPair(k);
+    LoadedPair images = next_.valid() && next_k_ == k ? next_.get() : LoadPair(k);
+    decode_cpu_ms_ += images.cpu_ms;
     if (k + 1 < pairs_.size()) {
       next_k_ = k + 1;
       next_ = std::async(std::launch::async, [this, k] { return LoadPair(k + 1); });
     }
-    return images;
+    return {images.left, images.right};
   }
 
-  std::pair<cv::Mat, cv::Mat> LoadPair(size_t k) {
-    return {Load(0, pairs_[k].left), Load(1, pairs_[k].right)};
+  LoadedPair LoadPair(size_t k) {
+    const double start_ms = ThreadCpuMs();
+    LoadedPair images{Load(0, pairs_[k].left), Load(1, pairs_[k].right)};
+    images.cpu_ms = ThreadCpuMs() - start_ms;
+    return images;
   }
 
   // The image of one data.csv row: a file under camN/data/, or a bag message.
@@ -131,8 +152,10 @@ class ImageFrameSource final : public FrameSource {
   std::optional<BagImageReader> bag_readers_[2];  ///< images from a ROS bag: one sequential reader per camera
   std::vector<Pair> pairs_;
   int unpaired_ = 0;
-  double load_ms_ = 0;
-  std::future<std::pair<cv::Mat, cv::Mat>> next_;  ///< read-ahead (declared last: joined first)
+  double load_ms_ = 0;          ///< waiting for images (wall clock)
+  double decode_cpu_ms_ = 0;    ///< reading and decoding, CPU time of the thread that did it
+  double frontend_cpu_ms_ = 0;  ///< the front end, CPU time of its thread
+  std::future<LoadedPair> next_;  ///< read-ahead (declared last: joined first)
   size_t next_k_ = 0;
 };
 
@@ -169,7 +192,9 @@ std::string ImageFrameSource::ReportJson() const {
      << ", \"stage_ms\": {\"load\": " << Number(load_ms_ / frames) << ", \"detect\": "
      << Number(s.time.detect_ms / frames) << ", \"stereo_match\": " << Number(s.time.stereo_ms / frames)
      << ", \"temporal_match\": " << Number(s.time.temporal_ms / frames) << ", \"reject\": "
-     << Number(s.time.reject_ms / frames) << ", \"frontend\": " << Number(s.time.total() / frames) << "}}";
+     << Number(s.time.reject_ms / frames) << ", \"frontend\": " << Number(s.time.total() / frames) << "}"
+     << ", \"cpu_ms\": {\"decode\": " << Number(decode_cpu_ms_ / frames)
+     << ", \"frontend\": " << Number(frontend_cpu_ms_ / frames) << "}}";
   return os.str();
 }
 
