@@ -7,8 +7,9 @@
 #include <unordered_set>
 #include <utility>
 
-#include <ceres/crs_matrix.h>
 #include <glog/logging.h>
+
+#include "vio/marginalization/block_system.h"
 
 namespace vio::marginalization {
 namespace {
@@ -140,95 +141,25 @@ int TangentDim(const ceres::Problem& problem, const std::vector<double*>& blocks
   return dim;
 }
 
-/// H = J^T J, b = J^T r of a CRS Jacobian, row by row: the rows are factors
-/// touching a few blocks (an earlier prior, the one dense factor, comes from
-/// its information instead: AddPrior).
-NormalEquations NormalEquationsOf(const ceres::CRSMatrix& J, const std::vector<double>& r) {
-  const int n = J.num_cols;
-  NormalEquations eq{Eigen::MatrixXd::Zero(n, n), Eigen::VectorXd::Zero(n)};
-  for (int i = 0; i < J.num_rows; ++i) {
-    const int begin = J.rows[i], end = J.rows[i + 1];
-    for (int a = begin; a < end; ++a) {
-      eq.b[J.cols[a]] += J.values[a] * r[i];
-      for (int c = begin; c < end; ++c) eq.H(J.cols[a], J.cols[c]) += J.values[a] * J.values[c];
-    }
-  }
-  return eq;
-}
-
-/// An earlier marginalization prior without a loss: its normal equations come
-/// from its information (O(n^2)) instead of its dense Jacobian (O(n^3)).
-const MarginalizationPrior* AsPrior(const ceres::Problem& problem, ceres::ResidualBlockId id) {
-  if (problem.GetLossFunctionForResidualBlock(id) != nullptr) return nullptr;
-  return dynamic_cast<const MarginalizationPrior*>(problem.GetCostFunctionForResidualBlock(id));
-}
-
-/// Adds a prior's tangent normal equations into `eq` at the blanket columns
-/// of its blocks (-1 in `column_of`: a constant block, skipped).
-void AddPrior(const ceres::Problem& problem, ceres::ResidualBlockId id, const MarginalizationPrior& prior,
-              const std::unordered_map<const double*, int>& column_of, NormalEquations* eq) {
-  std::vector<double*> blocks;
-  problem.GetParameterBlocksForResidualBlock(id, &blocks);
-  Eigen::MatrixXd H;
-  Eigen::VectorXd g;
+/// H and b of the blanket's residual blocks over [kept, marg_dense] on the
+/// tangent spaces, with the uncoupled marginalized blocks already
+/// Schur-complemented out block by block: the assembly the Gauss-Newton step
+/// uses (BlockSystem; earlier priors from their information, loss functions
+/// as Ceres applies them).
+NormalEquations ReducedBlanket(ceres::Problem* problem, const MarkovBlanket& blanket, const RankThreshold& threshold) {
+  BlockLayout layout;
+  layout.dense = blanket.kept;
+  layout.dense.insert(layout.dense.end(), blanket.marg_dense.begin(), blanket.marg_dense.end());
+  layout.eliminated = blanket.marg_uncoupled;
+  layout.residuals = blanket.residual_blocks;
+  BlockSystem system(problem, std::move(layout), threshold);
   double cost = 0.0;
-  if (!prior.TangentNormalEquations(blocks.data(), &H, &g, &cost)) {
-    throw std::runtime_error("marginalization: a marginalization prior does not evaluate on the Markov blanket");
+  if (!system.Reduce(&cost)) {
+    throw std::runtime_error("marginalization: the Markov blanket's residuals do not evaluate (or are not finite)");
   }
-  std::vector<int> columns(blocks.size(), -1);
-  for (size_t i = 0; i < blocks.size(); ++i) {
-    const auto found = column_of.find(blocks[i]);
-    if (found != column_of.end()) columns[i] = found->second;
-  }
-  for (size_t i = 0; i < blocks.size(); ++i) {
-    if (columns[i] < 0) continue;
-    const int oi = prior.tangent_offset(static_cast<int>(i)), ti = prior.tangent_size(static_cast<int>(i));
-    eq->b.segment(columns[i], ti) += g.segment(oi, ti);
-    for (size_t j = 0; j < blocks.size(); ++j) {
-      if (columns[j] < 0) continue;
-      const int oj = prior.tangent_offset(static_cast<int>(j)), tj = prior.tangent_size(static_cast<int>(j));
-      eq->H.block(columns[i], columns[j], ti, tj) += H.block(oi, oj, ti, tj);
-    }
-  }
-}
-
-/// H = J^T J and b = J^T r of the blanket's residual blocks, columns in the
-/// order [kept, marg_dense, marg_uncoupled], on the tangent spaces. Earlier
-/// priors are added from their information, the other blocks from
-/// Problem::Evaluate's Jacobian.
-NormalEquations Linearize(ceres::Problem* problem, const MarkovBlanket& blanket) {
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.apply_loss_function = true;
-  std::unordered_map<const double*, int> column_of;
-  int dim = 0;
-  for (const auto* group : {&blanket.kept, &blanket.marg_dense, &blanket.marg_uncoupled}) {
-    for (double* block : *group) {
-      evaluate.parameter_blocks.push_back(block);
-      column_of[block] = dim;
-      dim += problem->ParameterBlockTangentSize(block);
-    }
-  }
-  CHECK(!evaluate.parameter_blocks.empty()) << "an empty list would evaluate every block";
-  std::vector<std::pair<ceres::ResidualBlockId, const MarginalizationPrior*>> priors;
-  for (const ceres::ResidualBlockId id : blanket.residual_blocks) {
-    if (const MarginalizationPrior* prior = AsPrior(*problem, id)) {
-      priors.emplace_back(id, prior);
-    } else {
-      evaluate.residual_blocks.push_back(id);
-    }
-  }
-  NormalEquations eq{Eigen::MatrixXd::Zero(dim, dim), Eigen::VectorXd::Zero(dim)};
-  if (!evaluate.residual_blocks.empty()) {  // an empty list would evaluate every block
-    double cost = 0.0;
-    std::vector<double> residuals;
-    ceres::CRSMatrix jacobian;
-    if (!problem->Evaluate(evaluate, &cost, &residuals, nullptr, &jacobian)) {
-      throw std::runtime_error("marginalization: Problem::Evaluate failed on the Markov blanket");
-    }
-    eq = NormalEquationsOf(jacobian, residuals);
-  }
-  for (const auto& [id, prior] : priors) AddPrior(*problem, id, *prior, column_of, &eq);
-  return eq;
+  NormalEquations reduced;
+  system.MoveReducedTo(&reduced.H, &reduced.b);
+  return reduced;
 }
 
 std::vector<MarginalizationPrior::Block> PriorBlocks(const ceres::Problem& problem,
@@ -274,13 +205,7 @@ std::unique_ptr<MarginalizationPrior> BuildPrior(ceres::Problem* problem,
   const RankThreshold& threshold = options.rank_threshold;
   const int keep_dim = TangentDim(*problem, blanket.kept);
   const int dense_dim = TangentDim(*problem, blanket.marg_dense);
-  std::vector<int> uncoupled_dims;
-  for (const double* block : blanket.marg_uncoupled) {
-    uncoupled_dims.push_back(problem->ParameterBlockTangentSize(block));
-  }
-  const NormalEquations full = Linearize(problem, blanket);
-  const NormalEquations without_uncoupled = SchurComplementOfUncoupledBlocks(
-      full.H, full.b, keep_dim + dense_dim, uncoupled_dims, threshold);
+  const NormalEquations without_uncoupled = ReducedBlanket(problem, blanket, threshold);
   const NormalEquations marginal =
       SchurComplement(without_uncoupled.H, without_uncoupled.b, keep_dim, dense_dim, threshold);
   SqrtInformation sqrt =

@@ -15,7 +15,7 @@
 #include <Eigen/Geometry>
 
 #include "vio/estimator/so3.h"
-#include "vio/estimator/tangent_cost_function.h"
+#include "vio/marginalization/tangent_cost_function.h"
 #include "vio/estimator/types.h"
 
 namespace vio::test {
@@ -204,7 +204,7 @@ inline void ExpectTangentEvaluationMatchesAmbient(const ceres::CostFunction& cos
                                                   const std::vector<std::vector<double>>& parameters,
                                                   const std::vector<const ceres::Manifold*>& manifolds,
                                                   double relative_tolerance = 1e-12) {
-  const auto* on_tangents = dynamic_cast<const TangentCostFunction*>(&cost);
+  const auto* on_tangents = dynamic_cast<const marginalization::TangentCostFunction*>(&cost);
   ASSERT_NE(on_tangents, nullptr);
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   const int rows = cost.num_residuals();

@@ -382,6 +382,36 @@ TEST(MarginalizeBlocks, WidePriorFoldedIntoABlanketWithLandmarksIsExact) {
   ExpectExactMarginalOf(&model, &problem, kept);
 }
 
+// The second marginalization eliminates frame 1's 6-dimensional block by
+// itself (the smallest block, coupled to no other marginalized one but its
+// 9-dimensional partner, which is eliminated densely) while the first prior
+// involves it: the prior's information enters that block's own part of the
+// normal equations (BlockSystem's AddPrior), and the marginal stays exact.
+TEST(MarginalizeBlocks, PriorOnABlockEliminatedByItselfIsExact) {
+  LinearModel model(23);
+  std::vector<int> poses, speeds, landmarks;
+  for (int i = 0; i < 3; ++i) {
+    poses.push_back(model.AddVariable(6));
+    speeds.push_back(model.AddVariable(9));
+  }
+  for (int j = 0; j < 4; ++j)
+    landmarks.push_back(model.AddVariable(3));
+  model.AddFactor({poses[0], speeds[0]}, 15);
+  for (int i = 0; i + 1 < 3; ++i)
+    model.AddFactor({poses[i], speeds[i], poses[i + 1], speeds[i + 1]}, 15);
+  for (int j = 0; j < 4; ++j) {
+    for (const int pose : poses)
+      model.AddFactor({pose, landmarks[j]}, 3);
+  }
+  ceres::Problem problem;
+  model.AddAllToProblem(&problem);
+  ASSERT_NE(MarginalizeBlocks(&problem, {model.block(poses[0]), model.block(speeds[0])}), nullptr);
+  ASSERT_NE(MarginalizeBlocks(&problem, {model.block(poses[1]), model.block(speeds[1])}), nullptr);
+  std::vector<int> kept = {poses[2], speeds[2]};
+  kept.insert(kept.end(), landmarks.begin(), landmarks.end());
+  ExpectExactMarginalOf(&model, &problem, kept);
+}
+
 TEST(MarginalizeBlocks, EmptyBlanketRemovesTheBlockAndAddsNoPrior) {
   LinearModel model(1);
   const int a = model.AddVariable(2), b = model.AddVariable(3);

@@ -13,10 +13,12 @@
 // reduced system over the rest is solved by Cholesky, a chain of speed/bias
 // blocks first when its band is narrow (chain_solve.h), the rest densely.
 //
-// The normal equations are assembled per residual block (J_i^T J_j into the
-// upper block triangle, no sparse Jacobian); a marginalization prior enters
-// through its precomputed information Jp^T Jp. GaussNewtonSolver keeps that
-// structure and its buffers across the steps of one solve.
+// The normal equations and the elimination are marginalization::BlockSystem
+// (block_system.h), the one assembly the marginalization uses too: per
+// residual block, J_i^T J_j into the upper block triangle, no sparse Jacobian;
+// a marginalization prior through its stored information Jp^T Jp.
+// GaussNewtonSolver keeps that structure and its buffers across the steps of
+// one solve.
 #include <memory>
 #include <vector>
 

@@ -34,11 +34,11 @@
 #include <Eigen/Core>
 
 #include "vio/estimator/imu_preintegration.h"
-#include "vio/estimator/tangent_cost_function.h"
+#include "vio/marginalization/tangent_cost_function.h"
 
 namespace vio {
 
-class ImuFactor final : public ceres::SizedCostFunction<15, 7, 9, 7, 9>, public TangentCostFunction {
+class ImuFactor final : public ceres::SizedCostFunction<15, 7, 9, 7, 9>, public marginalization::TangentCostFunction {
  public:
   using Vector15d = Eigen::Matrix<double, 15, 1>;
 

@@ -19,12 +19,12 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "vio/estimator/tangent_cost_function.h"
+#include "vio/marginalization/tangent_cost_function.h"
 #include "vio/estimator/types.h"
 
 namespace vio {
 
-class StereoFactor final : public ceres::SizedCostFunction<3, 7, 3>, public TangentCostFunction {
+class StereoFactor final : public ceres::SizedCostFunction<3, 7, 3>, public marginalization::TangentCostFunction {
  public:
   /// Smallest depth [m] in the left camera that Evaluate accepts.
   static constexpr double kMinDepth = 1e-3;

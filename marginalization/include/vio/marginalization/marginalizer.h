@@ -4,12 +4,12 @@
 //
 //   1. C2 = every residual block touching a block to marginalize (x_M);
 //      the Markov blanket x_K = the other parameter blocks those touch.
-//   2. Problem::Evaluate(C2) at the current values, loss functions applied
-//      (Ceres' robust-loss correction), gives r and J in the TANGENT space of
-//      every block with a manifold: H = J^T J, b = J^T r.
-//   3. Schur complement removes x_M: landmark-like blocks that share no
-//      residual with another marginalized block are eliminated block by block,
-//      the rest densely (SchurComplementOfUncoupledBlocks, SchurComplement).
+//   2-3. The normal equations of C2 at the current values on the TANGENT
+//      space of every block, loss functions applied as Ceres applies them,
+//      with x_M removed by the Schur complement: landmark-like blocks that
+//      share no residual with another marginalized block block by block, as
+//      the Gauss-Newton step eliminates landmarks (BlockSystem, the one
+//      assembly both use: block_system.h), the rest densely (SchurComplement).
 //   4. (H*, b*) -> square root (Jp, r0) (SqrtInformationFromHessian) ->
 //      MarginalizationPrior over x_K with x0 = the current values of x_K.
 //
