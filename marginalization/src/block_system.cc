@@ -39,7 +39,7 @@ struct Slot {
   int ambient = 0;      ///< ambient (parameter block) size
   int jacobian = 0;     ///< offset of its (rows x tangent, row-major) Jacobian in the scratch buffer
   /// The block's PlusJacobian (ambient x tangent, row-major) in the solver's
-  /// per-step cache; nullptr for a Euclidean block (the identity).
+  /// per-assembly cache; nullptr for a Euclidean block (the identity).
   const RowMajorMatrix* plus_jacobian = nullptr;
   bool variable() const { return dense >= 0 || eliminated >= 0; }
 };
@@ -125,7 +125,7 @@ struct BlockSystem::Impl {
   int dense_dim = 0;
   std::vector<EliminatedBlock> eliminated;
   std::vector<Residual> residuals;
-  // Buffers reused by every step.
+  // Buffers reused by every Reduce().
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
   std::vector<double> r;
@@ -300,7 +300,7 @@ struct BlockSystem::Impl {
   // What Problem::EvaluateResidualBlock(apply_loss_function = true) gives,
   // without its per-call bookkeeping: the cost 0.5 rho(|r|^2), the residual
   // and the tangent Jacobians (from a TangentCostFunction directly, else
-  // ambient ones times the step's cached PlusJacobian), corrected for the loss
+  // ambient ones times the assembly's cached PlusJacobian), corrected for the loss
   // (ApplyLoss). False when the cost function fails or gives a non-finite value.
   bool EvaluateOnTangents(const Residual& residual, double* cost) {
     const int rows = residual.rows;
