@@ -88,16 +88,7 @@ struct GaussNewtonSolver::System {
   void FindChain() {
     std::vector<int> position(layout.dense.size(), -1);
     for (size_t k = 0; k < layout.chain.size(); ++k) position[layout.chain[k]] = static_cast<int>(k);
-    for (const std::vector<int>& group : equations.CoupledDenseBlocks()) {
-      int low = -1;
-      int high = -1;
-      for (const int d : group) {
-        if (d < 0 || position[d] < 0) continue;
-        low = low < 0 ? position[d] : std::min(low, position[d]);
-        high = std::max(high, position[d]);
-      }
-      chain_bandwidth = std::max(chain_bandwidth, high - low);
-    }
+    chain_bandwidth = equations.CouplingBandwidth(position);
     const int m = static_cast<int>(layout.chain.size());
     if (m < 2 || 4 * (chain_bandwidth + 1) > m) return;
     for (const int d : layout.chain) chain.push_back({equations.dense_offset(d), equations.dense_size(d)});

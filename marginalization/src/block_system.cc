@@ -149,6 +149,7 @@ struct BlockSystem::Impl {
   Impl(ceres::Problem* p, BlockLayout l, const RankThreshold& t) : problem(p), layout(std::move(l)), threshold(t) {
     // A lookup from variable block to its slot fields only: no order depends on the addresses.
     std::unordered_map<const double*, Slot> index;
+    index.reserve(layout.dense.size() + layout.eliminated.size());
     for (size_t k = 0; k < layout.dense.size(); ++k) {
       dense.push_back({dense_dim, problem->ParameterBlockTangentSize(layout.dense[k])});
       dense_dim += dense.back().size;
@@ -583,16 +584,24 @@ struct BlockSystem::Impl {
     return true;
   }
 
-  std::vector<std::vector<int>> CoupledDenseBlocks() const {
-    std::vector<std::vector<int>> groups;
-    for (const Residual& residual : residuals) {
-      std::vector<int>& group = groups.emplace_back();
-      for (const Slot& slot : residual.slots) {
-        if (slot.dense >= 0) group.push_back(slot.dense);
+  int CouplingBandwidth(const std::vector<int>& position) const {
+    int bandwidth = 0;
+    const auto widen = [&](int low, int high) { bandwidth = std::max(bandwidth, high - low); };
+    const auto span = [&](const auto& blocks, const auto& dense_of) {
+      int low = -1;
+      int high = -1;
+      for (const auto& block : blocks) {
+        const int d = dense_of(block);
+        if (d < 0 || position[static_cast<size_t>(d)] < 0) continue;
+        const int at = position[static_cast<size_t>(d)];
+        low = low < 0 ? at : std::min(low, at);
+        high = std::max(high, at);
       }
-    }
-    for (const EliminatedBlock& block : eliminated) groups.push_back(block.coupled);
-    return groups;
+      widen(low, high);
+    };
+    for (const Residual& residual : residuals) span(residual.slots, [](const Slot& slot) { return slot.dense; });
+    for (const EliminatedBlock& block : eliminated) span(block.coupled, [](int d) { return d; });
+    return bandwidth;
   }
 };
 
@@ -620,6 +629,8 @@ void BlockSystem::BackSubstitute(const Eigen::VectorXd& dx_dense, Eigen::VectorX
   impl_->BackSubstitute(dx_dense, dx);
 }
 bool BlockSystem::Cost(double* cost) { return impl_->Cost(cost); }
-std::vector<std::vector<int>> BlockSystem::CoupledDenseBlocks() const { return impl_->CoupledDenseBlocks(); }
+int BlockSystem::CouplingBandwidth(const std::vector<int>& position) const {
+  return impl_->CouplingBandwidth(position);
+}
 
 }  // namespace vio::marginalization

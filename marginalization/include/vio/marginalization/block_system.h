@@ -69,10 +69,11 @@ class BlockSystem {
   /// 1/2 sum rho(|r|^2) at the current values, without Jacobians; false when
   /// a residual does not evaluate or is not finite.
   bool Cost(double* cost);
-  /// The groups of dense blocks the reduced H couples: every residual's
-  /// dense blocks, and every eliminated block's coupled dense blocks (its
-  /// Schur update ties them together).
-  std::vector<std::vector<int>> CoupledDenseBlocks() const;
+  /// The widest gap in `position` (one entry per dense block, -1: not
+  /// counted) between two counted blocks that the reduced H couples: two
+  /// blocks of one residual, or two dense blocks one eliminated block's Schur
+  /// update ties together. A chain solver's bandwidth.
+  int CouplingBandwidth(const std::vector<int>& position) const;
 
  private:
   struct Impl;
