@@ -1,7 +1,7 @@
 #pragma once
 // One exact Gauss-Newton step on a ceres::Problem (paper §2.2): linearize every
-// residual at the current values (Problem::Evaluate: loss functions applied as
-// Ceres applies them, Jacobians on the tangent spaces), solve the normal
+// residual at the current values (each cost function evaluated, loss functions
+// applied as Ceres applies them, Jacobians on the tangent spaces), solve the normal
 // equations J^T J dx = -J^T r without damping, and apply x <- x ⊞ dx. The step
 // is always taken: no trust region, no line search; the caller may only undo a
 // step whose end point does not evaluate (UndoStep).

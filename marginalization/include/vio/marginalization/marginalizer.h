@@ -64,7 +64,8 @@ struct MarginalizationResult {
 };
 
 /// Computes the prior that marginalizing `to_marginalize` leaves on its Markov
-/// blanket, without changing the problem (Problem::Evaluate is not const).
+/// blanket, without changing the problem (the problem is not const: Ceres
+/// hands out its blocks through non-const accessors).
 /// Duplicates in `to_marginalize` are ignored. Throws std::invalid_argument if
 /// a block is not in the problem, std::runtime_error if evaluation fails.
 MarginalizationResult ComputeMarginalization(ceres::Problem* problem,
