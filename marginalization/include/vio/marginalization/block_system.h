@@ -56,15 +56,14 @@ class BlockSystem {
   /// Moves H (made symmetric) and b out, without copying them; H() and b()
   /// are empty until the next Reduce().
   void MoveReducedTo(Eigen::MatrixXd* H, Eigen::VectorXd* b);
-  /// Columns of the dense blocks, then of the eliminated ones.
+  /// Columns of the dense blocks.
   int dense_dim() const;
-  int dim() const;
   /// Column offset and tangent size of dense block k.
   int dense_offset(int k) const;
   int dense_size(int k) const;
   /// The eliminated blocks' part of the step for a step `dx_dense` of the
-  /// dense blocks (back-substitution): dx_e = -H_e^+ (b_e + W_e^T dx_dense),
-  /// written at the eliminated columns of `dx` (dim() long).
+  /// dense blocks (back-substitution): dx_e = -H_e^+ (b_e + W_e^T dx_dense);
+  /// `dx` gets dx_dense, then every eliminated block's step in layout order.
   void BackSubstitute(const Eigen::VectorXd& dx_dense, Eigen::VectorXd* dx) const;
   /// 1/2 sum rho(|r|^2) at the current values, without Jacobians; false when
   /// a residual does not evaluate or is not finite.

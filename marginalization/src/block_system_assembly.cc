@@ -1,0 +1,226 @@
+#include "block_system_impl.h"
+
+#include <cmath>
+#include <utility>
+
+#include <glog/logging.h>
+
+#include <Eigen/Core>
+
+namespace vio::marginalization {
+namespace {
+
+/// Ceres' Corrector on one row-major Jacobian: J <- sqrt_rho1 (J - alpha_sq_norm r (r^T J)).
+template <int Rows, typename Residuals>
+void CorrectJacobian(const Residuals& res, double alpha_sq_norm, double sqrt_rho1, int tangent, double* jacobian) {
+  Eigen::Map<Eigen::Matrix<double, Rows, Eigen::Dynamic, Eigen::RowMajor>> J(jacobian, res.size(), tangent);
+  if (alpha_sq_norm != 0.0) J -= alpha_sq_norm * res * (res.transpose() * J);
+  J *= sqrt_rho1;
+}
+
+/// The robust loss applied as Ceres applies it (its Corrector, after Triggs et
+/// al.): J <- sqrt(rho') (J - alpha r r^T J / |r|^2) for every (Jacobian,
+/// tangent size) in `jacobians`, then r <- sqrt(rho') r / (1 - alpha); returns
+/// the cost 0.5 rho(|r|^2).
+double ApplyLoss(const ceres::LossFunction& loss, Eigen::Map<Eigen::VectorXd> res,
+                 const std::vector<std::pair<double*, int>>& jacobians) {
+  const double squared_norm = res.squaredNorm();
+  double rho[3];
+  loss.Evaluate(squared_norm, rho);
+  const double sqrt_rho1 = std::sqrt(rho[1]);
+  double residual_scaling = sqrt_rho1;
+  double alpha_sq_norm = 0.0;
+  if (squared_norm != 0.0 && rho[2] > 0.0) {
+    const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * squared_norm * rho[2] / rho[1]);
+    residual_scaling = sqrt_rho1 / (1.0 - alpha);
+    alpha_sq_norm = alpha / squared_norm;
+  }
+  for (const auto& [jacobian, tangent] : jacobians) {
+    if (res.size() == 3) {  // stereo residuals, on fixed-size products
+      CorrectJacobian<3>(Eigen::Map<const Eigen::Vector3d>(res.data()), alpha_sq_norm, sqrt_rho1, tangent, jacobian);
+    } else {
+      CorrectJacobian<Eigen::Dynamic>(res, alpha_sq_norm, sqrt_rho1, tangent, jacobian);
+    }
+  }
+  res *= residual_scaling;
+  return 0.5 * rho[0];
+}
+
+}  // namespace
+
+// J_i^T J_j into the upper block triangle of H.
+template <typename JacobianI, typename JacobianJ>
+void BlockSystem::Impl::AddDensePair(const Slot& i, const Slot& j, const JacobianI& Ji, const JacobianJ& Jj) {
+  const Columns& a = dense[i.dense];
+  const Columns& c = dense[j.dense];
+  if (a.offset <= c.offset) {
+    H.block(a.offset, c.offset, a.size, c.size).noalias() += Ji.transpose() * Jj;
+  } else {
+    H.block(c.offset, a.offset, c.size, a.size).noalias() += Jj.transpose() * Ji;
+  }
+}
+
+// A product for blocks (i, j) into the upper block triangle of H.
+template <typename Product>
+void BlockSystem::Impl::AddDenseProduct(const Slot& i, const Slot& j, const Product& product) {
+  const Columns& a = dense[i.dense];
+  const Columns& c = dense[j.dense];
+  if (a.offset <= c.offset) {
+    H.block(a.offset, c.offset, a.size, c.size) += product;
+  } else {
+    H.block(c.offset, a.offset, c.size, a.size) += product.transpose();
+  }
+}
+
+bool BlockSystem::Impl::AddGeneric(const Residual& residual, double* cost) {
+  if (!EvaluateOnTangents(residual, cost)) return false;
+  // A stereo residual (3 rows on 6- and 3-dimensional tangents) takes
+  // fixed-size products; every other shape the dynamic ones.
+  if (residual.rows == 3 && HasTangentsOf3Or6(residual)) {
+    Accumulate(residual, Eigen::Map<const Eigen::Vector3d>(r.data()), [&](const Slot& slot, const auto& use) {
+      const double* data = jacobians.data() + slot.jacobian;
+      if (slot.tangent == 6) {
+        use(Eigen::Map<const Eigen::Matrix<double, 3, 6, Eigen::RowMajor>>(data));
+      } else {
+        use(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(data));
+      }
+    });
+    return true;
+  }
+  Accumulate(residual, Eigen::Map<const Eigen::VectorXd>(r.data(), residual.rows),
+             [&](const Slot& slot, const auto& use) {
+               use(ConstJacobian(jacobians.data() + slot.jacobian, residual.rows, slot.tangent));
+             });
+  return true;
+}
+
+// What Problem::EvaluateResidualBlock(apply_loss_function = true) gives,
+// without its per-call bookkeeping: the cost 0.5 rho(|r|^2), the residual
+// and the tangent Jacobians (from a TangentCostFunction directly, else
+// ambient ones times the assembly's cached PlusJacobian), corrected for the loss
+// (ApplyLoss). False when the cost function fails or gives a non-finite value.
+bool BlockSystem::Impl::EvaluateOnTangents(const Residual& residual, double* cost) {
+  const int rows = residual.rows;
+  const bool on_tangents = residual.on_tangents != nullptr;  // no ambient round trip
+  for (size_t k = 0, ambient = 0; k < residual.slots.size(); ++k) {
+    const Slot& slot = residual.slots[k];
+    if (!slot.variable()) {
+      jacobian_pointers[k] = nullptr;
+    } else if (slot.plus_jacobian == nullptr || on_tangents) {
+      jacobian_pointers[k] = jacobians.data() + slot.jacobian;
+    } else {
+      jacobian_pointers[k] = ambient_jacobians.data() + ambient;
+      ambient += static_cast<size_t>(rows * slot.ambient);
+    }
+  }
+  const bool evaluated =
+      on_tangents ? residual.on_tangents->EvaluateOnTangents(residual.values.data(), r.data(), jacobian_pointers.data())
+                  : residual.cost->Evaluate(residual.values.data(), r.data(), jacobian_pointers.data());
+  Eigen::Map<Eigen::VectorXd> res(r.data(), rows);
+  if (!evaluated || !res.allFinite()) return false;
+  tangent_jacobians.clear();
+  for (size_t k = 0; k < residual.slots.size(); ++k) {
+    const Slot& slot = residual.slots[k];
+    if (!slot.variable()) continue;
+    Eigen::Map<RowMajorMatrix> tangent(jacobians.data() + slot.jacobian, rows, slot.tangent);
+    if (slot.plus_jacobian != nullptr && !on_tangents) {
+      tangent.noalias() = Eigen::Map<const RowMajorMatrix>(jacobian_pointers[k], rows, slot.ambient) * *slot.plus_jacobian;
+    }
+    if (!tangent.allFinite()) return false;
+    tangent_jacobians.emplace_back(tangent.data(), slot.tangent);
+  }
+  *cost = residual.loss == nullptr ? 0.5 * res.squaredNorm() : ApplyLoss(*residual.loss, res, tangent_jacobians);
+  return std::isfinite(*cost);
+}
+
+// PlusJacobian of every variable block with a manifold at the current values.
+bool BlockSystem::Impl::RefreshPlusJacobians() {
+  for (size_t k = 0; k < manifold_blocks.size(); ++k) {
+    const auto& [manifold, values] = manifold_blocks[k];
+    plus_jacobians[k].resize(manifold->AmbientSize(), manifold->TangentSize());
+    if (!manifold->PlusJacobian(values, plus_jacobians[k].data())) return false;
+  }
+  return true;
+}
+
+bool BlockSystem::Impl::HasTangentsOf3Or6(const Residual& residual) {
+  for (const Slot& slot : residual.slots) {
+    if (slot.variable() && slot.tangent != 3 && slot.tangent != 6) return false;
+  }
+  return true;
+}
+
+// One residual's J^T J and J^T r into H and b (dense blocks) and into the
+// eliminated blocks' H, b and couplings W; with_jacobian(slot, use) calls
+// use with the slot's Jacobian.
+template <typename Residuals, typename WithJacobian>
+void BlockSystem::Impl::Accumulate(const Residual& residual, const Residuals& res, const WithJacobian& with_jacobian) {
+  for (size_t p = 0; p < residual.slots.size(); ++p) {
+    const Slot& i = residual.slots[p];
+    if (!i.variable()) continue;
+    with_jacobian(i, [&](const auto& Ji) {
+      if (i.dense >= 0) {
+        b.segment(dense[i.dense].offset, i.tangent).noalias() += Ji.transpose() * res;
+        for (size_t q = p; q < residual.slots.size(); ++q) {
+          const Slot& j = residual.slots[q];
+          if (j.dense >= 0) with_jacobian(j, [&](const auto& Jj) { AddDensePair(i, j, Ji, Jj); });
+        }
+        return;
+      }
+      EliminatedBlock& block = eliminated[i.eliminated];
+      block.b.noalias() += Ji.transpose() * res;
+      block.H.noalias() += Ji.transpose() * Ji;
+      for (const Slot& j : residual.slots) {
+        if (j.dense >= 0) {
+          with_jacobian(j, [&](const auto& Jj) { block.W[j.coupling].noalias() += Jj.transpose() * Ji; });
+        }
+      }
+    });
+  }
+}
+
+// A prior r = r0 + Jp delta, assembled from its information (see
+// MarginalizationPrior::TangentNormalEquations) without forming Jp T: its
+// blocks' parts go where a residual's J_i^T J_j would (H, b, or the
+// eliminated block's H, b and couplings W).
+bool BlockSystem::Impl::AddPrior(const Residual& residual, double* cost) {
+  const MarginalizationPrior& prior = *residual.prior;
+  if (!prior.TangentNormalEquations(residual.values.data(), &prior_H, &prior_g, cost)) return false;
+  const int n = static_cast<int>(residual.slots.size());
+  const auto part = [&](int i, int j) {
+    return prior_H.block(prior.tangent_offset(i), prior.tangent_offset(j), residual.slots[i].tangent,
+                         residual.slots[j].tangent);
+  };
+  for (int i = 0; i < n; ++i) {
+    const Slot& si = residual.slots[i];
+    const auto g = prior_g.segment(prior.tangent_offset(i), si.tangent);
+    if (si.eliminated >= 0) {
+      EliminatedBlock& block = eliminated[si.eliminated];
+      block.b += g;
+      block.H += part(i, i);
+      for (int j = 0; j < n; ++j) {
+        if (residual.slots[j].dense >= 0) block.W[residual.slots[j].coupling] += part(j, i);
+      }
+    }
+    if (si.dense < 0) continue;
+    b.segment(dense[si.dense].offset, si.tangent) += g;
+    for (int j = i; j < n; ++j) {
+      if (residual.slots[j].dense >= 0) AddDenseProduct(si, residual.slots[j], part(i, j));
+    }
+  }
+  return true;
+}
+
+bool BlockSystem::Impl::Assemble(double* cost) {
+  if (!RefreshPlusJacobians()) return false;
+  Zero();
+  *cost = 0;
+  for (const Residual& residual : residuals) {
+    double c = 0;
+    if (!(residual.prior != nullptr ? AddPrior(residual, &c) : AddGeneric(residual, &c))) return false;
+    *cost += c;
+  }
+  return true;
+}
+
+}  // namespace vio::marginalization
