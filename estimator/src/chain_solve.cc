@@ -5,8 +5,24 @@
 namespace vio {
 namespace {
 
-/// H(r, c) of a symmetric matrix stored in its upper triangle.
-double UpperEntry(const Eigen::MatrixXd& H, int r, int c) { return r <= c ? H(r, c) : H(c, r); }
+/// A maximal run of consecutive columns among ascending ones.
+struct Run {
+  int column = 0;    ///< its first column
+  int position = 0;  ///< the index of that column in the list
+  int length = 0;
+};
+
+std::vector<Run> RunsOf(const std::vector<int>& columns) {
+  std::vector<Run> runs;
+  for (int k = 0; k < static_cast<int>(columns.size()); ++k) {
+    if (!runs.empty() && columns[static_cast<size_t>(k)] == runs.back().column + runs.back().length) {
+      ++runs.back().length;
+    } else {
+      runs.push_back({columns[static_cast<size_t>(k)], k, 1});
+    }
+  }
+  return runs;
+}
 
 /// H's block (a, b) of a symmetric matrix stored in its upper triangle, for
 /// a.offset < b.offset or a == b.
@@ -82,6 +98,37 @@ void ChainSolver::SubtractCoupling() {
   }
 }
 
+// B = H_chain,rest and the upper triangle of S = H_rest,rest, copied block by
+// block: a run of consecutive rest columns lies wholly before or after a
+// chain block, so each piece is a block of H's upper triangle (or its
+// transpose), read column by column.
+void ChainSolver::GatherRest(const Eigen::MatrixXd& H, const std::vector<ChainBlock>& chain, int chain_dim) {
+  const int nr = static_cast<int>(rest_.size());
+  B_.resize(chain_dim, nr);
+  S_.resize(nr, nr);
+  const std::vector<Run> runs = RunsOf(rest_);
+  for (size_t i = 0; i < chain.size(); ++i) {
+    const ChainBlock& c = chain[i];
+    for (const Run& run : runs) {
+      auto to = B_.block(rows_[i], run.position, c.size, run.length);
+      if (run.column < c.offset) {
+        to = H.block(run.column, c.offset, run.length, c.size).transpose();
+      } else {
+        to = H.block(c.offset, run.column, c.size, run.length);
+      }
+    }
+  }
+  for (size_t a = 0; a < runs.size(); ++a) {
+    const Run& ra = runs[a];
+    S_.block(ra.position, ra.position, ra.length, ra.length).triangularView<Eigen::Upper>() =
+        H.block(ra.column, ra.column, ra.length, ra.length);
+    for (size_t b = a + 1; b < runs.size(); ++b) {
+      const Run& rb = runs[b];
+      S_.block(ra.position, rb.position, ra.length, rb.length) = H.block(ra.column, rb.column, ra.length, rb.length);
+    }
+  }
+}
+
 // With H_cc = L L^T, Z = H_cc^-1 H_cr and w = H_cc^-1 b_c: the rest solves
 // (H_rr - H_rc Z) dx_r = -(b_r - H_rc w), then dx_c = -(w + Z dx_r).
 bool ChainSolver::Solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, const std::vector<ChainBlock>& chain,
@@ -103,14 +150,8 @@ bool ChainSolver::Solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, cons
     if (!in_chain[c]) rest_.push_back(c);
   }
   if (!FactorChain(H, chain)) return false;
-  const int nc = static_cast<int>(chain_columns.size());
   const int nr = static_cast<int>(rest_.size());
-  B_.resize(nc, nr);
-  S_.resize(nr, nr);
-  for (int j = 0; j < nr; ++j) {
-    for (int i = 0; i < nc; ++i) B_(i, j) = UpperEntry(H, chain_columns[i], rest_[j]);
-    for (int i = 0; i <= j; ++i) S_(i, j) = H(rest_[i], rest_[j]);
-  }
+  GatherRest(H, chain, static_cast<int>(chain_columns.size()));
   Z_ = B_;
   ForwardSolve(Z_);
   BackwardSolve(Z_);

@@ -82,10 +82,18 @@ struct GaussNewtonSolver::System {
     FindChain();
   }
 
+  void Relayout(GaussNewtonLayout l) {
+    layout = std::move(l);
+    equations.Relayout(BlockLayoutOf(layout));
+    FindChain();
+    before_step.clear();
+  }
+
   // The chain's bandwidth: the widest gap in chain order between two chain
   // blocks that one residual, or one eliminated block's Schur update, couples.
   // Used when the band is narrow enough to beat the dense solve.
   void FindChain() {
+    chain.clear();
     std::vector<int> position(layout.dense.size(), -1);
     for (size_t k = 0; k < layout.chain.size(); ++k) position[layout.chain[k]] = static_cast<int>(k);
     chain_bandwidth = equations.CouplingBandwidth(position);
@@ -147,6 +155,8 @@ GaussNewtonSolver::GaussNewtonSolver(ceres::Problem* problem, GaussNewtonLayout 
     : system_(std::make_unique<System>(problem, std::move(layout))) {}
 
 GaussNewtonSolver::~GaussNewtonSolver() = default;
+
+void GaussNewtonSolver::Relayout(GaussNewtonLayout layout) { system_->Relayout(std::move(layout)); }
 
 GaussNewtonStep GaussNewtonSolver::Step() { return system_->Step(); }
 

@@ -155,7 +155,15 @@ SolveReport Window::TakeSteps(int steps, const SolverOptions& options) {
 // the `max_steps`.
 SolveReport Window::GaussNewton(int max_steps, bool until_converged, const SolverOptions& options) {
   SolveReport report;
-  auto solver = std::make_unique<GaussNewtonSolver>(problem_.get(), Layout());
+  const auto lay_out = [this] {
+    if (gauss_newton_ == nullptr) {
+      gauss_newton_ = std::make_unique<GaussNewtonSolver>(problem_.get(), Layout());
+    } else {
+      gauss_newton_->Relayout(Layout());
+    }
+  };
+  lay_out();
+  GaussNewtonSolver* solver = gauss_newton_.get();
   for (int k = 0; k < max_steps; ++k) {
     const GaussNewtonStep step = solver->Step();
     if (k == 0) report.initial_cost = report.final_cost = step.cost;
@@ -173,7 +181,7 @@ SolveReport Window::GaussNewton(int max_steps, bool until_converged, const Solve
                    << outliers.size() << " observation(s) that fail there dropped";
       if (outliers.empty()) break;
       DropOutlierObservations(outliers);
-      solver = std::make_unique<GaussNewtonSolver>(problem_.get(), Layout());
+      lay_out();
       --k;
       continue;
     }

@@ -14,8 +14,20 @@
 
 namespace vio::marginalization {
 
-BlockSystem::Impl::Impl(ceres::Problem* p, BlockLayout l, const RankThreshold& t)
-    : problem(p), layout(std::move(l)), threshold(t) {
+BlockSystem::Impl::Impl(ceres::Problem* p, BlockLayout l, const RankThreshold& t) : problem(p), threshold(t) {
+  Build(std::move(l));
+}
+
+// The structure of `l`; the buffers (H, the eliminated blocks' parts, the
+// scratch) keep their memory for a layout of the same sizes.
+void BlockSystem::Impl::Build(BlockLayout l) {
+  layout = std::move(l);
+  dense.clear();
+  dense_dim = 0;
+  residuals.clear();
+  residual_values.clear();
+  residual_slots.clear();
+  manifold_blocks.clear();
   // A lookup from variable block to its slot fields only: no order depends on the addresses.
   std::unordered_map<const double*, Slot> index;
   index.reserve(layout.dense.size() + layout.eliminated.size());
@@ -26,6 +38,7 @@ BlockSystem::Impl::Impl(ceres::Problem* p, BlockLayout l, const RankThreshold& t
   }
   int col = dense_dim;
   eliminated.resize(layout.eliminated.size());
+  for (EliminatedBlock& block : eliminated) block.coupled.clear();
   for (size_t k = 0; k < layout.eliminated.size(); ++k) {
     eliminated[k].columns = {col, problem->ParameterBlockTangentSize(layout.eliminated[k])};
     col += eliminated[k].columns.size;
@@ -50,6 +63,10 @@ BlockSystem::Impl::Impl(ceres::Problem* p, BlockLayout l, const RankThreshold& t
     ambient_scratch = std::max(ambient_scratch, ambient_size);
   }
   ambient_jacobians.resize(ambient_scratch);
+  for (Residual& residual : residuals) {  // the shared arrays are complete: point into them
+    residual.values = residual_values.data() + residual.first;
+    residual.slots.data = residual_slots.data() + residual.first;
+  }
   for (EliminatedBlock& block : eliminated) {
     std::sort(block.coupled.begin(), block.coupled.end());
     block.coupled.erase(std::unique(block.coupled.begin(), block.coupled.end()), block.coupled.end());
@@ -76,10 +93,13 @@ std::pair<size_t, size_t> BlockSystem::Impl::AddResidual(ceres::ResidualBlockId 
   residual.loss = problem->GetLossFunctionForResidualBlock(id);
   residual.on_tangents = dynamic_cast<const TangentCostFunction*>(cost);
   residual.rows = cost->num_residuals();
-  problem->GetParameterBlocksForResidualBlock(id, &residual.values);
+  problem->GetParameterBlocksForResidualBlock(id, &parameter_blocks);
+  residual.first = static_cast<int>(residual_values.size());
+  residual.slots.size = parameter_blocks.size();
+  residual_values.insert(residual_values.end(), parameter_blocks.begin(), parameter_blocks.end());
   int jacobian = 0;
   int ambient = 0;
-  for (const double* value : residual.values) {
+  for (const double* value : parameter_blocks) {
     // A block outside the layout is held constant: no Jacobian, no columns.
     const auto it = index.find(value);
     Slot slot = it != index.end() ? it->second : Slot{};
@@ -91,10 +111,11 @@ std::pair<size_t, size_t> BlockSystem::Impl::AddResidual(ceres::ResidualBlockId 
     slot.jacobian = jacobian;
     if (slot.variable()) jacobian += residual.rows * slot.tangent;
     if (slot.variable() && slot.plus_jacobian != nullptr) ambient = std::max(ambient, residual.rows * slot.ambient);
-    residual.slots.push_back(slot);
+    residual_slots.push_back(slot);
   }
   if (residual.eliminated >= 0) {
-    for (const Slot& slot : residual.slots) {
+    for (size_t k = residual.first; k < residual_slots.size(); ++k) {
+      const Slot& slot = residual_slots[k];
       if (slot.dense >= 0) eliminated[residual.eliminated].coupled.push_back(slot.dense);
     }
   }
@@ -102,9 +123,9 @@ std::pair<size_t, size_t> BlockSystem::Impl::AddResidual(ceres::ResidualBlockId 
     residual.prior = dynamic_cast<const MarginalizationPrior*>(cost);
   }
   r.resize(std::max(r.size(), static_cast<size_t>(residual.rows)));
-  jacobian_pointers.resize(std::max(jacobian_pointers.size(), residual.values.size()));
+  jacobian_pointers.resize(std::max(jacobian_pointers.size(), parameter_blocks.size()));
   if (residual.prior != nullptr) return {0, 0};  // from its information (AddPrior): no Jacobian scratch
-  return {static_cast<size_t>(jacobian), static_cast<size_t>(ambient) * residual.values.size()};
+  return {static_cast<size_t>(jacobian), static_cast<size_t>(ambient) * parameter_blocks.size()};
 }
 
 // Only H's upper triangle is read (the chain and dense solves, the rank
@@ -216,14 +237,18 @@ void BlockSystem::Impl::SubtractPendingUpdates() {
          ++end) {
       columns += eliminated[pending[end].block].U.cols();
     }
-    stacked.resize(group.rows, columns);
+    // Mapped on a buffer that only grows: the groups' sizes vary, and a
+    // matrix resized for each would reallocate (and page-fault) every time.
+    const auto needed = static_cast<size_t>(group.rows * columns);
+    if (stacked.size() < needed) stacked.resize(needed);
+    Eigen::Map<Eigen::MatrixXd> stacked_columns(stacked.data(), group.rows, columns);
     columns = 0;
     for (size_t k = begin; k < end; ++k) {
       const Eigen::MatrixXd& u = eliminated[pending[k].block].U;
-      stacked.middleCols(columns, u.cols()) = u;
+      stacked_columns.middleCols(columns, u.cols()) = u;
       columns += u.cols();
     }
-    H.block(group.first, group.first, group.rows, group.rows).selfadjointView<Eigen::Upper>().rankUpdate(stacked, -1.0);
+    H.block(group.first, group.first, group.rows, group.rows).selfadjointView<Eigen::Upper>().rankUpdate(stacked_columns, -1.0);
   }
 }
 
@@ -269,7 +294,7 @@ void BlockSystem::Impl::BackSubstitute(const Eigen::VectorXd& dx_dense, Eigen::V
 bool BlockSystem::Impl::Cost(double* cost) {
   *cost = 0;
   for (const Residual& residual : residuals) {
-    if (!residual.cost->Evaluate(residual.values.data(), r.data(), nullptr)) return false;
+    if (!residual.cost->Evaluate(residual.values, r.data(), nullptr)) return false;
     const double squared_norm = Eigen::Map<const Eigen::VectorXd>(r.data(), residual.rows).squaredNorm();
     if (!std::isfinite(squared_norm)) return false;
     double rho[3] = {squared_norm, 1, 0};
@@ -304,6 +329,8 @@ BlockSystem::BlockSystem(ceres::Problem* problem, BlockLayout layout, const Rank
     : impl_(std::make_unique<Impl>(problem, std::move(layout), threshold)) {}
 
 BlockSystem::~BlockSystem() = default;
+
+void BlockSystem::Relayout(BlockLayout layout) { impl_->Build(std::move(layout)); }
 
 bool BlockSystem::Reduce(double* cost) { return impl_->Reduce(cost); }
 const Eigen::MatrixXd& BlockSystem::H() const { return impl_->H; }

@@ -102,7 +102,7 @@ bool BlockSystem::Impl::AddGeneric(const Residual& residual, double* cost) {
 bool BlockSystem::Impl::EvaluateOnTangents(const Residual& residual, double* cost) {
   const int rows = residual.rows;
   const bool on_tangents = residual.on_tangents != nullptr;  // no ambient round trip
-  for (size_t k = 0, ambient = 0; k < residual.slots.size(); ++k) {
+  for (size_t k = 0, ambient = 0; k < residual.slots.size; ++k) {
     const Slot& slot = residual.slots[k];
     if (!slot.variable()) {
       jacobian_pointers[k] = nullptr;
@@ -114,12 +114,12 @@ bool BlockSystem::Impl::EvaluateOnTangents(const Residual& residual, double* cos
     }
   }
   const bool evaluated =
-      on_tangents ? residual.on_tangents->EvaluateOnTangents(residual.values.data(), r.data(), jacobian_pointers.data())
-                  : residual.cost->Evaluate(residual.values.data(), r.data(), jacobian_pointers.data());
+      on_tangents ? residual.on_tangents->EvaluateOnTangents(residual.values, r.data(), jacobian_pointers.data())
+                  : residual.cost->Evaluate(residual.values, r.data(), jacobian_pointers.data());
   Eigen::Map<Eigen::VectorXd> res(r.data(), rows);
   if (!evaluated || !res.allFinite()) return false;
   tangent_jacobians.clear();
-  for (size_t k = 0; k < residual.slots.size(); ++k) {
+  for (size_t k = 0; k < residual.slots.size; ++k) {
     const Slot& slot = residual.slots[k];
     if (!slot.variable()) continue;
     Eigen::Map<RowMajorMatrix> tangent(jacobians.data() + slot.jacobian, rows, slot.tangent);
@@ -155,13 +155,13 @@ bool BlockSystem::Impl::HasTangentsOf3Or6(const Residual& residual) {
 // use with the slot's Jacobian.
 template <typename Residuals, typename WithJacobian>
 void BlockSystem::Impl::Accumulate(const Residual& residual, const Residuals& res, const WithJacobian& with_jacobian) {
-  for (size_t p = 0; p < residual.slots.size(); ++p) {
+  for (size_t p = 0; p < residual.slots.size; ++p) {
     const Slot& i = residual.slots[p];
     if (!i.variable()) continue;
     with_jacobian(i, [&](const auto& Ji) {
       if (i.dense >= 0) {
         b.segment(dense[i.dense].offset, i.tangent).noalias() += Ji.transpose() * res;
-        for (size_t q = p; q < residual.slots.size(); ++q) {
+        for (size_t q = p; q < residual.slots.size; ++q) {
           const Slot& j = residual.slots[q];
           if (j.dense >= 0) with_jacobian(j, [&](const auto& Jj) { AddDensePair(i, j, Ji, Jj); });
         }
@@ -180,20 +180,21 @@ void BlockSystem::Impl::Accumulate(const Residual& residual, const Residuals& re
 }
 
 // A prior r = r0 + Jp delta, assembled from its information (see
-// MarginalizationPrior::TangentNormalEquations) without forming Jp T: its
-// blocks' parts go where a residual's J_i^T J_j would (H, b, or the
-// eliminated block's H, b and couplings W).
+// MarginalizationPrior::Linearize) without forming Jp T: its blocks' parts
+// go where a residual's J_i^T J_j would (H, b, or the eliminated block's H, b
+// and couplings W).
 bool BlockSystem::Impl::AddPrior(const Residual& residual, double* cost) {
   const MarginalizationPrior& prior = *residual.prior;
-  if (!prior.TangentNormalEquations(residual.values.data(), &prior_H, &prior_g, cost)) return false;
-  const int n = static_cast<int>(residual.slots.size());
-  const auto part = [&](int i, int j) {
-    return prior_H.block(prior.tangent_offset(i), prior.tangent_offset(j), residual.slots[i].tangent,
-                         residual.slots[j].tangent);
+  if (!prior.Linearize(residual.values, &prior_linearization)) return false;
+  *cost = prior_linearization.cost;
+  const int n = static_cast<int>(residual.slots.size);
+  const auto part = [&](int i, int j) -> const Eigen::MatrixXd& {
+    prior.TangentHessianBlock(prior_linearization, i, j, &prior_part);
+    return prior_part;
   };
   for (int i = 0; i < n; ++i) {
     const Slot& si = residual.slots[i];
-    const auto g = prior_g.segment(prior.tangent_offset(i), si.tangent);
+    const auto g = prior_linearization.g.segment(prior.tangent_offset(i), si.tangent);
     if (si.eliminated >= 0) {
       EliminatedBlock& block = eliminated[si.eliminated];
       block.b += g;

@@ -44,7 +44,19 @@ struct Slot {
   bool variable() const { return dense >= 0 || eliminated >= 0; }
 };
 
+/// A view of `size` consecutive elements of one of Impl's arrays.
+template <typename T>
+struct Span {
+  T* data = nullptr;
+  size_t size = 0;
+  T* begin() const { return data; }
+  T* end() const { return data + size; }
+  T& operator[](size_t k) const { return data[k]; }
+};
+
 /// A residual block and the columns it touches, found once per BlockSystem.
+/// Its parameter blocks and slots live in the BlockSystem's shared arrays
+/// (one allocation for all residuals, not two per residual).
 struct Residual {
   ceres::ResidualBlockId id = nullptr;
   const ceres::CostFunction* cost = nullptr;
@@ -54,8 +66,9 @@ struct Residual {
   int rows = 0;
   /// A marginalization prior without a loss: assembled from its information (AddPrior).
   const MarginalizationPrior* prior = nullptr;
-  std::vector<double*> values;  ///< its parameter blocks, in the residual's order
-  std::vector<Slot> slots;
+  int first = 0;                ///< index of its first parameter block and slot in the shared arrays
+  double* const* values = nullptr;  ///< its parameter blocks, in the residual's order
+  Span<Slot> slots;                 ///< one per parameter block
   int eliminated = -1;  ///< the eliminated block it touches, -1 for none
 };
 
@@ -86,6 +99,7 @@ using block_system_detail::PendingUpdate;
 using block_system_detail::Residual;
 using block_system_detail::RowMajorMatrix;
 using block_system_detail::Slot;
+using block_system_detail::Span;
 
 // The normal equations of the dense columns (upper block triangle) and the
 // per-block parts of the eliminated ones, summed in the layout's residual order.
@@ -97,6 +111,9 @@ struct BlockSystem::Impl {
   int dense_dim = 0;
   std::vector<EliminatedBlock> eliminated;
   std::vector<Residual> residuals;
+  std::vector<double*> residual_values;  ///< every residual's parameter blocks, one after the other
+  std::vector<Slot> residual_slots;      ///< every residual's slots, one after the other
+  std::vector<double*> parameter_blocks;  ///< one residual's, while the structure is found
   // Buffers reused by every Reduce().
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
@@ -109,17 +126,18 @@ struct BlockSystem::Impl {
   /// manifold (dense, then eliminated blocks), refreshed once per assembly.
   std::vector<RowMajorMatrix> plus_jacobians;
   std::vector<std::pair<const ceres::Manifold*, const double*>> manifold_blocks;
-  Eigen::MatrixXd prior_H;
-  Eigen::VectorXd prior_g;
+  MarginalizationPrior::TangentLinearization prior_linearization;
+  Eigen::MatrixXd prior_part;  ///< one block of a prior's J^T J
   Eigen::MatrixXd U;
   Eigen::MatrixXd UUt;
   /// Contiguous Schur updates waiting to be applied (SubtractPendingUpdates).
   std::vector<PendingUpdate> pending;
-  Eigen::MatrixXd stacked;
+  std::vector<double> stacked;  ///< a group's U side by side (SubtractPendingUpdates)
   Eigen::MatrixXd UL;
 
   // block_system.cc: structure, elimination, back-substitution, cost.
   Impl(ceres::Problem* p, BlockLayout l, const RankThreshold& t);
+  void Build(BlockLayout l);
   std::pair<size_t, size_t> AddResidual(ceres::ResidualBlockId id, const std::unordered_map<const double*, Slot>& index);
   void Zero();
   void Eliminate();

@@ -121,22 +121,37 @@ bool MarginalizationPrior::TangentJacobians(double const* const* parameters, Eig
   return true;
 }
 
-bool MarginalizationPrior::TangentNormalEquations(double const* const* parameters, Eigen::MatrixXd* H,
-                                                  Eigen::VectorXd* g, double* cost) const {
+bool MarginalizationPrior::Linearize(double const* const* parameters, TangentLinearization* at) const {
   Eigen::VectorXd delta;
-  std::vector<Eigen::MatrixXd> T;
-  if (!TangentJacobians(parameters, &delta, &T)) return false;
-  *cost = 0.5 * (residual_at_x0_ + sqrt_information_ * delta).squaredNorm();
-  *g = information_vector_ + information_ * delta;
-  *H = information_;
+  if (!TangentJacobians(parameters, &delta, &at->T)) return false;
+  at->cost = 0.5 * (residual_at_x0_ + sqrt_information_ * delta).squaredNorm();
+  at->g = information_vector_ + information_ * delta;
   for (size_t i = 0; i < blocks_.size(); ++i) {
-    if (T[i].isIdentity(0.0)) continue;
-    const int offset = tangent_offsets_[i], size = tangent_sizes_[i];
-    H->middleRows(offset, size) = T[i].transpose() * H->middleRows(offset, size);
-    H->middleCols(offset, size) = H->middleCols(offset, size) * T[i];
-    g->segment(offset, size) = T[i].transpose() * g->segment(offset, size);
+    Eigen::MatrixXd& T = at->T[i];
+    if (T.isIdentity(0.0)) {
+      T.resize(0, 0);
+    } else {
+      at->g.segment(tangent_offsets_[i], tangent_sizes_[i]) = T.transpose() * at->g.segment(tangent_offsets_[i], tangent_sizes_[i]);
+    }
   }
   return true;
+}
+
+void MarginalizationPrior::TangentHessianBlock(const TangentLinearization& at, int i, int j,
+                                               Eigen::MatrixXd* block) const {
+  const auto information =
+      information_.block(tangent_offsets_[i], tangent_offsets_[j], tangent_sizes_[i], tangent_sizes_[j]);
+  const Eigen::MatrixXd& T_i = at.T[static_cast<size_t>(i)];
+  const Eigen::MatrixXd& T_j = at.T[static_cast<size_t>(j)];
+  if (T_i.size() == 0 && T_j.size() == 0) {
+    *block = information;
+  } else if (T_i.size() == 0) {
+    block->noalias() = information * T_j;
+  } else if (T_j.size() == 0) {
+    block->noalias() = T_i.transpose() * information;
+  } else {
+    block->noalias() = T_i.transpose() * (information * T_j);
+  }
 }
 
 bool MarginalizationPrior::Evaluate(double const* const* parameters, double* residuals,

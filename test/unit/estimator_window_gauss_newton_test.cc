@@ -127,6 +127,27 @@ TEST(WindowGaussNewton, OneStepWithAMarginalizationPriorOffItsLinearizationPoint
   EXPECT_LE(LargestDifference(Values(window.problem()), expected), 1e-10);
 }
 
+// The window keeps one solver and re-lays it out for every solve, reusing its
+// buffers: after a step on ten states, marginalizing the oldest (one state and
+// its landmarks fewer, a prior more) leaves a different layout, and the next
+// step is still the closed form of the new window's cost.
+TEST(WindowGaussNewton, AStepAfterTheWindowChangedEqualsTheClosedFormStep) {
+  Window window(Model(), Flight().stereo());
+  Flight().Build(window, Model(), kFirst, kFrames, kOffsetM);
+  SolverOptions gn;
+  gn.step = "gn";
+  ASSERT_TRUE(window.TakeSteps(1, gn).usable);
+  const size_t landmarks_before = window.landmarks().size();
+  window.Marginalize({window.states().begin()->first}, {window.landmarks().begin()->first});
+  ASSERT_LT(window.landmarks().size(), landmarks_before);
+  const auto before = Values(window.problem());
+  const auto expected = ClosedFormStep(window.problem());
+  ASSERT_GT(LargestDifference(expected, before), 1e-6);
+
+  ASSERT_TRUE(window.TakeSteps(1, gn).usable);
+  EXPECT_LE(LargestDifference(Values(window.problem()), expected), 1e-10);
+}
+
 /// The normal equations of `layout` the sparse-Jacobian way (J from
 /// Problem::Evaluate as a CRS matrix, then dense): H = J^T J, b = J^T r over
 /// the dense columns followed by the eliminated ones.

@@ -235,22 +235,33 @@ TEST_F(MarginalizationPriorTest, CeresGradientCheckerAcceptsTheAmbientJacobians)
   EXPECT_TRUE(checker.Probe(parameters.data(), 1e-6, &results)) << results.error_log;
 }
 
-TEST_F(MarginalizationPriorTest, TangentNormalEquationsAreTheJacobianProducts) {
+TEST_F(MarginalizationPriorTest, TangentLinearizationIsTheJacobianProducts) {
   // What the Gauss-Newton solver and the marginalizer assemble from the stored
   // information equals J^T J, J^T r and 0.5 |r|^2 of the residual and tangent
   // Jacobian themselves, away from x0 where T_i != I.
   const auto x = Perturbed(0.3);
   std::vector<const double*> parameters;
   for (const auto& block : x) parameters.push_back(block.data());
-  Eigen::MatrixXd H;
-  Eigen::VectorXd g;
-  double cost = 0.0;
-  ASSERT_TRUE(prior_->TangentNormalEquations(parameters.data(), &H, &g, &cost));
+  MarginalizationPrior::TangentLinearization at;
+  ASSERT_TRUE(prior_->Linearize(parameters.data(), &at));
   const Eigen::MatrixXd J = AnalyticTangentJacobian(x);
   const Eigen::VectorXd r = Residual(x);
-  EXPECT_LE((H - J.transpose() * J).norm(), 1e-12 * H.norm());
-  EXPECT_LE((g - J.transpose() * r).norm(), 1e-12 * g.norm());
-  EXPECT_NEAR(cost, 0.5 * r.squaredNorm(), 1e-12 * cost);
+  const Eigen::MatrixXd JtJ = J.transpose() * J;
+  const int blocks = static_cast<int>(x.size());
+  int non_identity = 0;
+  for (int i = 0; i < blocks; ++i) {
+    non_identity += at.T[static_cast<size_t>(i)].size() > 0;
+    for (int j = 0; j < blocks; ++j) {
+      Eigen::MatrixXd block;
+      prior_->TangentHessianBlock(at, i, j, &block);
+      const auto expected = JtJ.block(prior_->tangent_offset(i), prior_->tangent_offset(j), prior_->tangent_size(i),
+                                      prior_->tangent_size(j));
+      EXPECT_LE((block - expected).norm(), 1e-12 * JtJ.norm()) << "block (" << i << ", " << j << ")";
+    }
+  }
+  EXPECT_GT(non_identity, 0);
+  EXPECT_LE((at.g - J.transpose() * r).norm(), 1e-12 * at.g.norm());
+  EXPECT_NEAR(at.cost, 0.5 * r.squaredNorm(), 1e-12 * at.cost);
 }
 
 TEST_F(MarginalizationPriorTest, GivenInformationIsKeptAndChecked) {

@@ -36,6 +36,7 @@ class ChainSolver {
   bool FactorChain(const Eigen::MatrixXd& H, const std::vector<ChainBlock>& chain);
   void ForwardSolve(Eigen::Ref<Eigen::MatrixXd> r) const;
   void BackwardSolve(Eigen::Ref<Eigen::MatrixXd> z) const;
+  void GatherRest(const Eigen::MatrixXd& H, const std::vector<ChainBlock>& chain, int chain_dim);
   void SubtractCoupling();
   const Eigen::MatrixXd& L(int i, int j) const { return below_[i][i - j - 1]; }
   int First(int i) const { return i - bandwidth_ > 0 ? i - bandwidth_ : 0; }

@@ -66,13 +66,18 @@ bool ReducedNormalEquations(ceres::Problem* problem, const GaussNewtonLayout& la
 
 /// Successive Gauss-Newton steps on one problem whose blocks and residuals do
 /// not change between the steps (the values do): the residual-to-column
-/// structure is found once, the buffers are reused.
+/// structure is found once per layout, the buffers are reused.
 class GaussNewtonSolver {
  public:
   GaussNewtonSolver(ceres::Problem* problem, GaussNewtonLayout layout);
   ~GaussNewtonSolver();
   GaussNewtonSolver(const GaussNewtonSolver&) = delete;
   GaussNewtonSolver& operator=(const GaussNewtonSolver&) = delete;
+
+  /// Solves for `layout` from now on, as a new solver would, keeping the
+  /// buffers' memory (a window's successive solves have layouts of about one
+  /// size). UndoStep() is not available until the next Step().
+  void Relayout(GaussNewtonLayout layout);
 
   /// One undamped step on the layout's blocks (see TakeGaussNewtonStep).
   GaussNewtonStep Step();

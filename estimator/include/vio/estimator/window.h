@@ -228,6 +228,9 @@ class Window {
   Removals removals_;
   WindowHealth health_;
   FactorWrapper wrapper_;
+  /// The exact Gauss-Newton path's solver, re-laid out for every solve: its
+  /// buffers (a window's normal equations, a few MB) are reused frame after frame.
+  std::unique_ptr<GaussNewtonSolver> gauss_newton_;
 };
 
 }  // namespace vio

@@ -46,6 +46,12 @@ class BlockSystem {
   BlockSystem(const BlockSystem&) = delete;
   BlockSystem& operator=(const BlockSystem&) = delete;
 
+  /// Becomes the system of another layout of the same problem (the next
+  /// frame's window), as a new BlockSystem would, keeping the memory of its
+  /// buffers: no reallocation, and no fresh pages to fault in, when the sizes
+  /// repeat.
+  void Relayout(BlockLayout layout);
+
   /// Assembles at the current values and eliminates; `cost` = 1/2 sum rho(|r|^2).
   /// False when a residual does not evaluate or gives a non-finite value.
   bool Reduce(double* cost);

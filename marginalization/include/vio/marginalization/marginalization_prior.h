@@ -79,11 +79,22 @@ class MarginalizationPrior final : public ceres::CostFunction {
   const Eigen::MatrixXd& information() const { return information_; }
   /// Jp^T r0, computed once.
   const Eigen::VectorXd& information_vector() const { return information_vector_; }
-  /// The prior's normal equations on the stacked tangent spaces at
-  /// `parameters`, from information(): H = T^T (Jp^T Jp) T, g = T^T (Jp^T r0 +
-  /// Jp^T Jp delta) (= J^T r), and cost = 0.5 |r|^2. O(n^2), no Jp T formed.
-  bool TangentNormalEquations(double const* const* parameters, Eigen::MatrixXd* H, Eigen::VectorXd* g,
-                              double* cost) const;
+  /// The prior linearized on the stacked tangent spaces at some parameters
+  /// (Linearize), in the factored form its normal equations are assembled
+  /// from block by block, without an n x n copy of information().
+  struct TangentLinearization {
+    /// Per block, T_i (see TangentJacobians); empty for the identity.
+    std::vector<Eigen::MatrixXd> T;
+    /// J^T r = T^T (Jp^T r0 + Jp^T Jp delta).
+    Eigen::VectorXd g;
+    /// 0.5 |r|^2.
+    double cost = 0.0;
+  };
+  /// The prior at `parameters`; O(n^2), no Jp T formed. False when a block's
+  /// local coordinates do not evaluate.
+  bool Linearize(double const* const* parameters, TangentLinearization* at) const;
+  /// Block (i, j) of J^T J at `at`: T_i^T information()_ij T_j.
+  void TangentHessianBlock(const TangentLinearization& at, int i, int j, Eigen::MatrixXd* block) const;
   /// Column of block i in sqrt_information().
   int tangent_offset(int i) const { return tangent_offsets_[i]; }
   int tangent_size(int i) const { return tangent_sizes_[i]; }
@@ -95,7 +106,7 @@ class MarginalizationPrior final : public ceres::CostFunction {
 
   /// The stacked deltas [x_i ⊟ x0_i] at `parameters`, and per block T_i (tangent x
   /// tangent, see above): the tangent Jacobian of r is Jp_i T_i, used by
-  /// TangentNormalEquations.
+  /// Linearize.
   bool TangentJacobians(double const* const* parameters, Eigen::VectorXd* delta,
                         std::vector<Eigen::MatrixXd>* T) const;
   /// delta_i = x_i ⊟ x0_i written into the tangent_size(i) values at `delta`.
