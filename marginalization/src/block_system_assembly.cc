@@ -188,9 +188,17 @@ bool BlockSystem::Impl::AddPrior(const Residual& residual, double* cost) {
   if (!prior.Linearize(residual.values, &prior_linearization)) return false;
   *cost = prior_linearization.cost;
   const int n = static_cast<int>(residual.slots.size);
-  const auto part = [&](int i, int j) -> const Eigen::MatrixXd& {
-    prior.TangentHessianBlock(prior_linearization, i, j, &prior_part);
-    return prior_part;
+  // use(block (i, j) of the prior's J^T J): the stored information itself
+  // where both T are the identity (Euclidean blocks, FEJ), else T_i^T I_ij T_j.
+  const auto with_part = [&](int i, int j, const auto& use) {
+    if (prior_linearization.T[static_cast<size_t>(i)].size() == 0 &&
+        prior_linearization.T[static_cast<size_t>(j)].size() == 0) {
+      use(prior.information().block(prior.tangent_offset(i), prior.tangent_offset(j), prior.tangent_size(i),
+                                    prior.tangent_size(j)));
+    } else {
+      prior.TangentHessianBlock(prior_linearization, i, j, &prior_part);
+      use(prior_part);
+    }
   };
   for (int i = 0; i < n; ++i) {
     const Slot& si = residual.slots[i];
@@ -198,15 +206,17 @@ bool BlockSystem::Impl::AddPrior(const Residual& residual, double* cost) {
     if (si.eliminated >= 0) {
       EliminatedBlock& block = eliminated[si.eliminated];
       block.b += g;
-      block.H += part(i, i);
+      with_part(i, i, [&](const auto& part) { block.H += part; });
       for (int j = 0; j < n; ++j) {
-        if (residual.slots[j].dense >= 0) block.W[residual.slots[j].coupling] += part(j, i);
+        const Slot& sj = residual.slots[j];
+        if (sj.dense >= 0) with_part(j, i, [&](const auto& part) { block.W[sj.coupling] += part; });
       }
     }
     if (si.dense < 0) continue;
     b.segment(dense[si.dense].offset, si.tangent) += g;
     for (int j = i; j < n; ++j) {
-      if (residual.slots[j].dense >= 0) AddDenseProduct(si, residual.slots[j], part(i, j));
+      const Slot& sj = residual.slots[j];
+      if (sj.dense >= 0) with_part(i, j, [&](const auto& part) { AddDenseProduct(si, sj, part); });
     }
   }
   return true;
