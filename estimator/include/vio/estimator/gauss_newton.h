@@ -18,7 +18,7 @@
 // residual block, J_i^T J_j into the upper block triangle, no sparse Jacobian;
 // a marginalization prior through its stored information Jp^T Jp.
 // GaussNewtonSolver keeps that structure and its buffers across the steps of
-// one solve.
+// one solve, and its buffers across solves (Relayout: the window keeps one).
 #include <memory>
 #include <vector>
 
