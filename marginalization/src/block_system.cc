@@ -248,7 +248,9 @@ void BlockSystem::Impl::SubtractPendingUpdates() {
       stacked_columns.middleCols(columns, u.cols()) = u;
       columns += u.cols();
     }
-    H.block(group.first, group.first, group.rows, group.rows).selfadjointView<Eigen::Upper>().rankUpdate(stacked_columns, -1.0);
+    H.block(group.first, group.first, group.rows, group.rows)
+        .selfadjointView<Eigen::Upper>()
+        .rankUpdate(stacked_columns, -1.0);
   }
 }
 

@@ -131,7 +131,8 @@ bool MarginalizationPrior::Linearize(double const* const* parameters, TangentLin
     if (T.isIdentity(0.0)) {
       T.resize(0, 0);
     } else {
-      at->g.segment(tangent_offsets_[i], tangent_sizes_[i]) = T.transpose() * at->g.segment(tangent_offsets_[i], tangent_sizes_[i]);
+      auto g = at->g.segment(tangent_offsets_[i], tangent_sizes_[i]);
+      g = T.transpose() * g;
     }
   }
   return true;
