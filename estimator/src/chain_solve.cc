@@ -31,6 +31,30 @@ Eigen::MatrixXd UpperBlock(const Eigen::MatrixXd& H, const ChainBlock& a, const 
   return H.block(a.offset, b.offset, a.size, b.size);
 }
 
+/// A chain block's matrix as an N x N one (N = Eigen::Dynamic: any size).
+template <int N>
+Eigen::Map<const Eigen::Matrix<double, N, N>> Fixed(const Eigen::MatrixXd& m) {
+  return {m.data(), m.rows(), m.cols()};
+}
+
+/// Rows [at, at + a.rows()) of r -= a times rows [from, from + a.cols()):
+/// a coefficient-based product along r's contiguous rows, unrolled when the
+/// block size N is fixed (the blocked product's packing costs as much as the
+/// product itself at 9 x 9).
+template <int N, typename Matrix>
+void SubtractProduct(const Matrix& a, int from, int at, ChainSolver::RowMajorMatrix* r) {
+  const Eigen::Matrix<double, N, N> a_plain = a;  // a transpose evaluated: the product's inner loop reads it
+  r->middleRows<N>(at, a.rows()) -= a_plain.lazyProduct(r->middleRows<N>(from, a.cols()));
+}
+
+/// Rows [at, at + a.rows()) of r <- a times themselves.
+template <int N, typename Matrix>
+void MultiplyInPlace(const Matrix& a, int at, ChainSolver::RowMajorMatrix* r, ChainSolver::RowMajorMatrix* scratch) {
+  const Eigen::Matrix<double, N, N> a_plain = a;
+  *scratch = a_plain.lazyProduct(r->middleRows<N>(at, a.cols()));
+  r->middleRows<N>(at, a.rows()) = *scratch;
+}
+
 }  // namespace
 
 // Block-banded Cholesky H_cc = L L^T, block row by block row.
@@ -51,29 +75,33 @@ bool ChainSolver::FactorChain(const Eigen::MatrixXd& H, const std::vector<ChainB
     diagonal_[i].compute(d);
     if (diagonal_[i].info() != Eigen::Success) return false;
   }
+  inverse_.resize(m);
+  for (int i = 0; i < m; ++i) {
+    inverse_[i].setIdentity(diagonal_[i].rows(), diagonal_[i].rows());
+    diagonal_[i].matrixL().solveInPlace(inverse_[i]);
+  }
   return true;
 }
 
-// r <- L^-1 r, r with one row block per chain block.
-void ChainSolver::ForwardSolve(Eigen::Ref<Eigen::MatrixXd> r) const {
+// r <- L^-1 r, r with one row block per chain block (the diagonal blocks'
+// inverses: a product instead of a substitution).
+template <int N>
+void ChainSolver::ForwardSolve(RowMajorMatrix* r) {
   for (int i = 0; i < static_cast<int>(diagonal_.size()); ++i) {
-    const int size = static_cast<int>(diagonal_[i].rows());
-    for (int k = First(i); k < i; ++k) {
-      r.middleRows(rows_[i], size).noalias() -= L(i, k) * r.middleRows(rows_[k], L(i, k).cols());
-    }
-    diagonal_[i].matrixL().solveInPlace(r.middleRows(rows_[i], size));
+    for (int k = First(i); k < i; ++k) SubtractProduct<N>(Fixed<N>(L(i, k)), rows_[k], rows_[i], r);
+    MultiplyInPlace<N>(Fixed<N>(inverse_[i]), rows_[i], r, &scratch_);
   }
 }
 
 // z <- L^-T z, z with one row block per chain block.
-void ChainSolver::BackwardSolve(Eigen::Ref<Eigen::MatrixXd> z) const {
+template <int N>
+void ChainSolver::BackwardSolve(RowMajorMatrix* z) {
   const int m = static_cast<int>(diagonal_.size());
   for (int i = m - 1; i >= 0; --i) {
-    const int size = static_cast<int>(diagonal_[i].rows());
     for (int k = i + 1; k < std::min(m, i + bandwidth_ + 1); ++k) {
-      z.middleRows(rows_[i], size).noalias() -= L(k, i).transpose() * z.middleRows(rows_[k], L(k, i).rows());
+      SubtractProduct<N>(Fixed<N>(L(k, i)).transpose(), rows_[k], rows_[i], z);
     }
-    diagonal_[i].matrixU().solveInPlace(z.middleRows(rows_[i], size));
+    MultiplyInPlace<N>(Fixed<N>(inverse_[i]).transpose(), rows_[i], z, &scratch_);
   }
 }
 
@@ -82,6 +110,7 @@ void ChainSolver::BackwardSolve(Eigen::Ref<Eigen::MatrixXd> z) const {
 // IMU factors: two poses; a prior: the poses it spans), in runs of adjacent
 // columns, so this costs nnz(H_cr) x rest instead of the chain x rest^2 of
 // forming (L^-1 H_cr)^T (L^-1 H_cr). Only S's upper triangle is formed.
+template <int N>
 void ChainSolver::SubtractCoupling() {
   const int nr = static_cast<int>(rest_.size());
   for (size_t i = 0; i < rows_.size(); ++i) {
@@ -91,8 +120,12 @@ void ChainSolver::SubtractCoupling() {
       if (!coupled(first)) continue;
       int end = first + 1;
       while (coupled(end)) ++end;
-      S_.block(first, first, end - first, nr - first).noalias() -=
-          B_.block(rows_[i], first, size, end - first).transpose() * Z_.block(rows_[i], first, size, nr - first);
+      // The square part's upper triangle (all of S_ that is read), then the columns right of it.
+      const auto B_run = B_.block<N, Eigen::Dynamic>(rows_[i], first, size, end - first).transpose();
+      S_.block(first, first, end - first, end - first).triangularView<Eigen::Upper>() -=
+          B_run * Z_.block<N, Eigen::Dynamic>(rows_[i], first, size, end - first);
+      S_.block(first, end, end - first, nr - end).noalias() -=
+          B_run * Z_.block<N, Eigen::Dynamic>(rows_[i], end, size, nr - end);
       first = end;
     }
   }
@@ -129,6 +162,16 @@ void ChainSolver::GatherRest(const Eigen::MatrixXd& H, const std::vector<ChainBl
   }
 }
 
+// Z <- H_cc^-1 Z, w <- H_cc^-1 w, then S -= H_rc Z.
+template <int N>
+void ChainSolver::SolveChain() {
+  ForwardSolve<N>(&Z_);
+  BackwardSolve<N>(&Z_);
+  ForwardSolve<N>(&w_);
+  BackwardSolve<N>(&w_);
+  SubtractCoupling<N>();
+}
+
 // With H_cc = L L^T, Z = H_cc^-1 H_cr and w = H_cc^-1 b_c: the rest solves
 // (H_rr - H_rc Z) dx_r = -(b_r - H_rc w), then dx_c = -(w + Z dx_r).
 bool ChainSolver::Solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, const std::vector<ChainBlock>& chain,
@@ -152,24 +195,26 @@ bool ChainSolver::Solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, cons
   if (!FactorChain(H, chain)) return false;
   const int nr = static_cast<int>(rest_.size());
   GatherRest(H, chain, static_cast<int>(chain_columns.size()));
+  // Speed/bias blocks (9) on fixed-size products, any other chain generically.
+  const bool nine = std::all_of(chain.begin(), chain.end(), [](const ChainBlock& c) { return c.size == 9; });
   Z_ = B_;
-  ForwardSolve(Z_);
-  BackwardSolve(Z_);
   w_ = b(chain_columns);
-  ForwardSolve(w_);
-  BackwardSolve(w_);
-  SubtractCoupling();
+  if (nine) {
+    SolveChain<9>();
+  } else {
+    SolveChain<Eigen::Dynamic>();
+  }
   dx_rest_.resize(nr);
   if (nr > 0) {
     const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Upper> llt(S_);  // in place
     if (llt.info() != Eigen::Success) return false;
-    dx_rest_.noalias() = B_.transpose() * w_;
+    dx_rest_.noalias() = B_.transpose() * w_.col(0);
     dx_rest_ -= b(rest_);
     llt.solveInPlace(dx_rest_);
   }
-  w_.noalias() += Z_ * dx_rest_;
+  w_.col(0).noalias() += Z_ * dx_rest_;
   dx->resize(n);
-  (*dx)(chain_columns) = -w_;
+  (*dx)(chain_columns) = -w_.col(0);
   (*dx)(rest_) = dx_rest_;
   return dx->allFinite();
 }

@@ -81,6 +81,7 @@ void BlockSystem::Impl::Build(BlockLayout l) {
     }
   }
   jacobians.resize(scratch);
+  FindStructure();
 }
 
 // The residual's slots; returns the scratch its tangent Jacobians and its
@@ -128,12 +129,60 @@ std::pair<size_t, size_t> BlockSystem::Impl::AddResidual(ceres::ResidualBlockId 
   return {static_cast<size_t>(jacobian), static_cast<size_t>(ambient) * parameter_blocks.size()};
 }
 
+// The dense block pairs an assembly writes, as rectangles of H's upper block
+// triangle (runs of adjacent blocks merged): a residual's pairs (a prior's
+// too), the diagonal blocks, and for each eliminated block every pair over
+// the span of its coupled blocks (its Schur update goes over that span, whose
+// gap rows of U are zero; pair by pair it writes fewer). A superset is safe:
+// the blocks are cleared, not assumed non-zero.
+void BlockSystem::Impl::FindStructure() {
+  const size_t m = dense.size();
+  std::vector<char> coupled(m * m, 0);
+  const auto pair = [&](int a, int c) { coupled[static_cast<size_t>(std::min(a, c)) * m + std::max(a, c)] = 1; };
+  std::vector<int> reach(m);  // row block a: every column block up to reach[a] is written
+  for (size_t a = 0; a < m; ++a) reach[a] = static_cast<int>(a);
+  for (const Residual& residual : residuals) {
+    for (const Slot& i : residual.slots) {
+      if (i.dense < 0) continue;
+      for (const Slot& j : residual.slots) {
+        if (j.dense >= 0) pair(i.dense, j.dense);
+      }
+    }
+  }
+  for (const EliminatedBlock& block : eliminated) {
+    if (block.coupled.empty()) continue;
+    for (int a = block.coupled.front(); a <= block.coupled.back(); ++a) {
+      reach[a] = std::max(reach[a], block.coupled.back());
+    }
+  }
+  structure.clear();
+  for (size_t a = 0; a < m; ++a) {
+    for (size_t c = a; c < m; ++c) {
+      if (!coupled[a * m + c] && static_cast<int>(c) > reach[a]) continue;
+      const bool extends = !structure.empty() && structure.back().row == dense[a].offset &&
+                           structure.back().col + structure.back().cols == dense[c].offset;
+      if (extends) {
+        structure.back().cols += dense[c].size;
+      } else {
+        structure.push_back({dense[a].offset, dense[c].offset, dense[a].size, dense[c].size});
+      }
+    }
+  }
+}
+
 // Only H's upper triangle is read (the chain and dense solves, the rank
 // updates); the diagonal blocks are written whole, so they are zeroed whole.
+// Outside the blocks the last assembly wrote H is already zero: only those are
+// cleared (for a window, a fraction of H: the speed/bias blocks couple little).
 void BlockSystem::Impl::Zero() {
-  H.resize(dense_dim, dense_dim);
-  H.triangularView<Eigen::Upper>().setZero();
-  for (const Columns& c : dense) H.block(c.offset, c.offset, c.size, c.size).setZero();
+  if (H.rows() != dense_dim || H.cols() != dense_dim) {  // new, or moved out (MoveReducedTo)
+    H.resize(dense_dim, dense_dim);
+    H.triangularView<Eigen::Upper>().setZero();
+    for (const Columns& c : dense) H.block(c.offset, c.offset, c.size, c.size).setZero();
+  } else {
+    for (const Rectangle& r : written) H.block(r.row, r.col, r.rows, r.cols).setZero();
+  }
+  written = structure;
   b.setZero(dense_dim);
   for (EliminatedBlock& block : eliminated) {
     const int n = block.columns.size;

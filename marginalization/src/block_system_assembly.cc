@@ -98,7 +98,9 @@ bool BlockSystem::Impl::AddGeneric(const Residual& residual, double* cost) {
 // without its per-call bookkeeping: the cost 0.5 rho(|r|^2), the residual
 // and the tangent Jacobians (from a TangentCostFunction directly, else
 // ambient ones times the assembly's cached PlusJacobian), corrected for the loss
-// (ApplyLoss). False when the cost function fails or gives a non-finite value.
+// (ApplyLoss). False when the cost function fails or the cost is not finite
+// (a non-finite residual makes it so); a non-finite Jacobian is caught once
+// per assembly, on the sums it enters (AssembledFinite).
 bool BlockSystem::Impl::EvaluateOnTangents(const Residual& residual, double* cost) {
   const int rows = residual.rows;
   const bool on_tangents = residual.on_tangents != nullptr;  // no ambient round trip
@@ -117,7 +119,7 @@ bool BlockSystem::Impl::EvaluateOnTangents(const Residual& residual, double* cos
       on_tangents ? residual.on_tangents->EvaluateOnTangents(residual.values, r.data(), jacobian_pointers.data())
                   : residual.cost->Evaluate(residual.values, r.data(), jacobian_pointers.data());
   Eigen::Map<Eigen::VectorXd> res(r.data(), rows);
-  if (!evaluated || !res.allFinite()) return false;
+  if (!evaluated) return false;
   tangent_jacobians.clear();
   for (size_t k = 0; k < residual.slots.size; ++k) {
     const Slot& slot = residual.slots[k];
@@ -126,7 +128,6 @@ bool BlockSystem::Impl::EvaluateOnTangents(const Residual& residual, double* cos
     if (slot.plus_jacobian != nullptr && !on_tangents) {
       tangent.noalias() = Eigen::Map<const RowMajorMatrix>(jacobian_pointers[k], rows, slot.ambient) * *slot.plus_jacobian;
     }
-    if (!tangent.allFinite()) return false;
     tangent_jacobians.emplace_back(tangent.data(), slot.tangent);
   }
   *cost = residual.loss == nullptr ? 0.5 * res.squaredNorm() : ApplyLoss(*residual.loss, res, tangent_jacobians);
@@ -222,6 +223,17 @@ bool BlockSystem::Impl::AddPrior(const Residual& residual, double* cost) {
   return true;
 }
 
+// Every Jacobian entry enters, squared, a diagonal entry of H or of an
+// eliminated block's H: a non-finite one leaves a non-finite diagonal. One
+// check of the sums instead of one per Jacobian entry.
+bool BlockSystem::Impl::AssembledFinite() const {
+  if (!H.diagonal().allFinite() || !b.allFinite()) return false;
+  for (const EliminatedBlock& block : eliminated) {
+    if (!block.H.diagonal().allFinite() || !block.b.allFinite()) return false;
+  }
+  return true;
+}
+
 bool BlockSystem::Impl::Assemble(double* cost) {
   if (!RefreshPlusJacobians()) return false;
   Zero();
@@ -231,7 +243,7 @@ bool BlockSystem::Impl::Assemble(double* cost) {
     if (!(residual.prior != nullptr ? AddPrior(residual, &c) : AddGeneric(residual, &c))) return false;
     *cost += c;
   }
-  return true;
+  return AssembledFinite();
 }
 
 }  // namespace vio::marginalization

@@ -83,6 +83,14 @@ struct EliminatedBlock {
   Eigen::MatrixXd U;               ///< its Schur update is -U U^T on contiguous coupled columns
 };
 
+/// A block of H's upper block triangle: rows of one dense block, columns of another.
+struct Rectangle {
+  int row = 0;
+  int col = 0;
+  int rows = 0;
+  int cols = 0;
+};
+
 /// A Schur update -U U^T waiting to be applied to rows [first, first + rows).
 struct PendingUpdate {
   int first = 0;
@@ -96,6 +104,7 @@ using block_system_detail::Columns;
 using block_system_detail::ConstJacobian;
 using block_system_detail::EliminatedBlock;
 using block_system_detail::PendingUpdate;
+using block_system_detail::Rectangle;
 using block_system_detail::Residual;
 using block_system_detail::RowMajorMatrix;
 using block_system_detail::Slot;
@@ -114,6 +123,13 @@ struct BlockSystem::Impl {
   std::vector<double*> residual_values;  ///< every residual's parameter blocks, one after the other
   std::vector<Slot> residual_slots;      ///< every residual's slots, one after the other
   std::vector<double*> parameter_blocks;  ///< one residual's, while the structure is found
+  /// The blocks of H an assembly of this layout can make non-zero (those of
+  /// two dense blocks one residual or one eliminated block's Schur update
+  /// couples, and the diagonal ones): found with the structure.
+  std::vector<Rectangle> structure;
+  /// The blocks the last assembly may have written: all of H's upper triangle
+  /// outside them is zero, so Zero() clears only them.
+  std::vector<Rectangle> written;
   // Buffers reused by every Reduce().
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
@@ -139,6 +155,7 @@ struct BlockSystem::Impl {
   Impl(ceres::Problem* p, BlockLayout l, const RankThreshold& t);
   void Build(BlockLayout l);
   std::pair<size_t, size_t> AddResidual(ceres::ResidualBlockId id, const std::unordered_map<const double*, Slot>& index);
+  void FindStructure();
   void Zero();
   void Eliminate();
   void StackCouplings(const EliminatedBlock& block, int first, int rows);
@@ -162,6 +179,7 @@ struct BlockSystem::Impl {
   template <typename Residuals, typename WithJacobian>
   void Accumulate(const Residual& residual, const Residuals& res, const WithJacobian& with_jacobian);
   bool AddPrior(const Residual& residual, double* cost);
+  bool AssembledFinite() const;
   bool Assemble(double* cost);
 };
 

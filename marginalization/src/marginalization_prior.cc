@@ -150,6 +150,11 @@ void MarginalizationPrior::TangentHessianBlock(const TangentLinearization& at, i
     block->noalias() = information * T_j;
   } else if (T_j.size() == 0) {
     block->noalias() = T_i.transpose() * information;
+  } else if (T_i.rows() == 6 && T_i.cols() == 6 && T_j.rows() == 6 && T_j.cols() == 6) {
+    // Two poses (the common pair): fixed-size products, no temporary on the heap.
+    using Matrix6 = Eigen::Matrix<double, 6, 6>;
+    const Matrix6 information_T_j = information * Eigen::Map<const Matrix6>(T_j.data());
+    block->noalias() = Eigen::Map<const Matrix6>(T_i.data()).transpose() * information_T_j;
   } else {
     block->noalias() = T_i.transpose() * (information * T_j);
   }

@@ -21,14 +21,15 @@ struct System {
   std::vector<ChainBlock> chain;
 };
 
-/// k pose-like 6-dim blocks first, then k chain blocks of 9; the chain's part
-/// of H couples blocks at most `bandwidth` apart; every other entry is dense.
-System MakeSystem(int k, int bandwidth, int seed) {
+/// k pose-like 6-dim blocks first, then k chain blocks of `chain_size` (9:
+/// speed/bias); the chain's part of H couples blocks at most `bandwidth`
+/// apart; every other entry is dense.
+System MakeSystem(int k, int bandwidth, int seed, int chain_size = 9) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> normal;
-  const int n = 15 * k;
+  const int n = (6 + chain_size) * k;
   System system;
-  for (int i = 0; i < k; ++i) system.chain.push_back({6 * k + 9 * i, 9});
+  for (int i = 0; i < k; ++i) system.chain.push_back({6 * k + chain_size * i, chain_size});
   // H = J^T J + I from a random J, then the chain's out-of-band blocks cleared
   // (which keeps H symmetric; the diagonal shift keeps it positive definite).
   Eigen::MatrixXd J(2 * n, n);
@@ -39,7 +40,7 @@ System MakeSystem(int k, int bandwidth, int seed) {
   for (int i = 0; i < k; ++i) {
     for (int j = 0; j < k; ++j) {
       if (std::abs(i - j) <= bandwidth) continue;
-      system.H.block(system.chain[i].offset, system.chain[j].offset, 9, 9).setZero();
+      system.H.block(system.chain[i].offset, system.chain[j].offset, chain_size, chain_size).setZero();
     }
   }
   system.b = Eigen::VectorXd::NullaryExpr(n, [&]() { return normal(rng); });
@@ -58,6 +59,18 @@ TEST(ChainSolve, EqualsTheDenseCholeskyStepForEveryBandwidth) {
     ASSERT_TRUE(ChainSolver().Solve(upper, system.b, system.chain, bandwidth, &dx)) << bandwidth;
     const Eigen::VectorXd expected = DenseStep(system);
     EXPECT_LT((dx - expected).norm(), 1e-12 * expected.norm()) << "bandwidth " << bandwidth;
+  }
+}
+
+// Speed/bias chains take fixed-size 9 x 9 products; any other block size the
+// dynamic-size ones, with the same result.
+TEST(ChainSolve, EqualsTheDenseCholeskyStepForChainBlocksOfAnotherSize) {
+  for (const int chain_size : {4, 12}) {
+    const System system = MakeSystem(10, 1, 17 + chain_size, chain_size);
+    Eigen::VectorXd dx;
+    ASSERT_TRUE(ChainSolver().Solve(system.H, system.b, system.chain, 1, &dx)) << chain_size;
+    const Eigen::VectorXd expected = DenseStep(system);
+    EXPECT_LT((dx - expected).norm(), 1e-12 * expected.norm()) << "chain blocks of " << chain_size;
   }
 }
 

@@ -4,10 +4,14 @@
 // closed-form step dx = -(J^T J)^-1 J^T r of the whole cost, with J and r
 // evaluated independently (every block, Ceres' own column order, dense QR),
 // applied through each block's manifold. LM's first step is not that step.
+#include <cmath>
+#include <limits>
 #include <map>
+#include <tuple>
 #include <vector>
 
 #include <ceres/crs_matrix.h>
+#include <ceres/sized_cost_function.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
@@ -146,6 +150,95 @@ TEST(WindowGaussNewton, AStepAfterTheWindowChangedEqualsTheClosedFormStep) {
 
   ASSERT_TRUE(window.TakeSteps(1, gn).usable);
   EXPECT_LE(LargestDifference(Values(window.problem()), expected), 1e-10);
+}
+
+// A solver re-laid out onto a system of the same size but fewer couplings (the
+// stereo residuals only: no IMU factor ties poses to speed/bias blocks) must
+// give what a fresh assembly gives: the blocks only the first layout wrote are
+// cleared, not left over (the assembly clears only the blocks it wrote last).
+TEST(WindowGaussNewton, ARelayoutOntoFewerCouplingsLeavesNothingOfTheFirstSystem) {
+  Window window(Model(), Flight().stereo());
+  Flight().Build(window, Model(), kFirst, kFrames, kOffsetM);
+  ceres::Problem& problem = window.problem();
+  const GaussNewtonLayout all = window.Layout();
+  GaussNewtonLayout stereo_only = all;
+  stereo_only.residuals.clear();
+  for (ceres::ResidualBlockId id : all.residuals) {
+    if (problem.GetCostFunctionForResidualBlock(id)->num_residuals() == 3) stereo_only.residuals.push_back(id);
+  }
+  ASSERT_LT(stereo_only.residuals.size(), all.residuals.size());
+  GaussNewtonSolver solver(&problem, all);
+  ReducedSystem first;
+  ASSERT_TRUE(solver.Reduce(&first));
+  solver.Relayout(stereo_only);
+  ReducedSystem relaid;
+  ASSERT_TRUE(solver.Reduce(&relaid));
+  ReducedSystem fresh;
+  ASSERT_TRUE(ReducedNormalEquations(&problem, stereo_only, &fresh));
+  ASSERT_EQ(relaid.H.rows(), first.H.rows());
+  ASSERT_GT((first.H - fresh.H).norm(), 1e-3 * fresh.H.norm());  // the IMU factors' blocks differ
+  EXPECT_EQ((relaid.H - fresh.H).norm(), 0.0);
+  EXPECT_EQ((relaid.b - fresh.b).norm(), 0.0);
+}
+
+/// r = x_dense[0] + x_eliminated[0] - 1 on a 2-dim dense and a 3-dim
+/// eliminated block; entry `bad` of the Jacobian of block `block` (or of the
+/// residual, block -1) is `value`.
+class PoisonedCost final : public ceres::SizedCostFunction<1, 2, 3> {
+ public:
+  PoisonedCost(int block, int bad, double value) : block_(block), bad_(bad), value_(value) {}
+  bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override {
+    residuals[0] = x[0][0] + x[1][0] - 1.0;
+    if (block_ < 0) residuals[0] = value_;
+    if (jacobians == nullptr) return true;
+    for (int k = 0; k < 2; ++k) {
+      if (jacobians[k] == nullptr) continue;
+      const int size = k == 0 ? 2 : 3;
+      for (int c = 0; c < size; ++c) jacobians[k][c] = c == 0 ? 1.0 : 0.5;
+      if (k == block_) jacobians[k][bad_] = value_;
+    }
+    return true;
+  }
+
+ private:
+  int block_, bad_;
+  double value_;
+};
+
+// A non-finite residual or Jacobian entry, in a dense or an eliminated block,
+// fails the step (checked once per assembly on the sums it enters), and the
+// values stay where they were.
+TEST(GaussNewtonSolver, ANonFiniteResidualOrJacobianEntryFailsTheStep) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const auto& [block, bad, value] : std::vector<std::tuple<int, int, double>>{
+           {-1, 0, nan}, {-1, 0, inf}, {0, 1, nan}, {0, 0, inf}, {1, 2, nan}, {1, 1, -inf}, {0, 1, 2.0}}) {
+    ceres::Problem::Options options;
+    options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+    ceres::Problem problem(options);
+    double dense[2] = {0.2, 0.3};
+    double eliminated[3] = {0.1, 0.0, 0.0};
+    problem.AddParameterBlock(dense, 2);
+    problem.AddParameterBlock(eliminated, 3);
+    GaussNewtonLayout layout;
+    layout.dense = {dense};
+    layout.eliminated = {eliminated};
+    // Enough residuals that the system is definite when nothing is poisoned.
+    for (int k = 0; k < 6; ++k) {
+      const bool poisoned = k == 3;
+      layout.residuals.push_back(problem.AddResidualBlock(
+          new PoisonedCost(poisoned ? block : 0, poisoned ? bad : 0, poisoned ? value : 1.0 + k), nullptr, dense,
+          eliminated));
+    }
+    GaussNewtonSolver solver(&problem, layout);
+    ReducedSystem system;
+    const bool finite = std::isfinite(value);
+    EXPECT_EQ(solver.Reduce(&system), finite) << block << " " << bad << " " << value;
+    if (finite) continue;
+    EXPECT_FALSE(solver.Step().ok) << block << " " << bad << " " << value;
+    EXPECT_EQ(dense[0], 0.2);
+    EXPECT_EQ(eliminated[0], 0.1);
+  }
 }
 
 /// The normal equations of `layout` the sparse-Jacobian way (J from

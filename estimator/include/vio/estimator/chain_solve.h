@@ -27,6 +27,10 @@ struct ChainBlock {
 /// window's Gauss-Newton steps solve systems of one shape).
 class ChainSolver {
  public:
+  /// The chain's right-hand sides, one row block per chain block: row-major,
+  /// so a block's rows are contiguous and its products run along them.
+  using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
   /// False when a factor is not positive definite (the caller falls back to a
   /// dense solve); `dx` is then unspecified.
   bool Solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, const std::vector<ChainBlock>& chain, int bandwidth,
@@ -34,9 +38,15 @@ class ChainSolver {
 
  private:
   bool FactorChain(const Eigen::MatrixXd& H, const std::vector<ChainBlock>& chain);
-  void ForwardSolve(Eigen::Ref<Eigen::MatrixXd> r) const;
-  void BackwardSolve(Eigen::Ref<Eigen::MatrixXd> z) const;
+  /// N: the chain blocks' size when all share it at compile time, else Eigen::Dynamic.
+  template <int N>
+  void SolveChain();
+  template <int N>
+  void ForwardSolve(RowMajorMatrix* r);
+  template <int N>
+  void BackwardSolve(RowMajorMatrix* z);
   void GatherRest(const Eigen::MatrixXd& H, const std::vector<ChainBlock>& chain, int chain_dim);
+  template <int N>
   void SubtractCoupling();
   const Eigen::MatrixXd& L(int i, int j) const { return below_[i][i - j - 1]; }
   int First(int i) const { return i - bandwidth_ > 0 ? i - bandwidth_ : 0; }
@@ -45,11 +55,13 @@ class ChainSolver {
   std::vector<int> rows_;  ///< first row of each chain block among the chain's columns
   std::vector<int> rest_;  ///< the columns not in the chain, ascending
   std::vector<Eigen::LLT<Eigen::MatrixXd>> diagonal_;  ///< L(i, i) L(i, i)^T
+  std::vector<Eigen::MatrixXd> inverse_;  ///< L(i, i)^-1: a small dense product instead of a substitution
   std::vector<std::vector<Eigen::MatrixXd>> below_;    ///< below_[i][i - j - 1] = L(i, j), j < i in the band
-  Eigen::MatrixXd B_;  ///< H_chain,rest
-  Eigen::MatrixXd Z_;  ///< H_chain,chain^-1 H_chain,rest
+  RowMajorMatrix B_;  ///< H_chain,rest
+  RowMajorMatrix Z_;  ///< H_chain,chain^-1 H_chain,rest
   Eigen::MatrixXd S_;  ///< H_rest,rest - H_rest,chain Z (upper triangle used)
-  Eigen::VectorXd w_;  ///< H_chain,chain^-1 b_chain
+  RowMajorMatrix w_;  ///< H_chain,chain^-1 b_chain (one column)
+  RowMajorMatrix scratch_;  ///< one row block of a right-hand side
   Eigen::VectorXd dx_rest_;
 };
 
