@@ -81,7 +81,7 @@ void BlockSystem::Impl::Build(BlockLayout l) {
     }
   }
   jacobians.resize(scratch);
-  FindStructure();
+  structure_found = false;
 }
 
 // The residual's slots; returns the scratch its tangent Jacobians and its
@@ -172,17 +172,25 @@ void BlockSystem::Impl::FindStructure() {
 
 // Only H's upper triangle is read (the chain and dense solves, the rank
 // updates); the diagonal blocks are written whole, so they are zeroed whole.
-// Outside the blocks the last assembly wrote H is already zero: only those are
-// cleared (for a window, a fraction of H: the speed/bias blocks couple little).
+// When H is reused (a window's solver, step after step and frame after
+// frame), H is already zero outside the blocks the last assembly wrote: only
+// those are cleared. A system assembled once (a marginalization's) never
+// finds its structure.
 void BlockSystem::Impl::Zero() {
-  if (H.rows() != dense_dim || H.cols() != dense_dim) {  // new, or moved out (MoveReducedTo)
+  const bool reused = H.rows() == dense_dim && H.cols() == dense_dim;  // not new, not moved out (MoveReducedTo)
+  if (reused && written_known) {
+    for (const Rectangle& r : written) H.block(r.row, r.col, r.rows, r.cols).setZero();
+  } else {
     H.resize(dense_dim, dense_dim);
     H.triangularView<Eigen::Upper>().setZero();
     for (const Columns& c : dense) H.block(c.offset, c.offset, c.size, c.size).setZero();
-  } else {
-    for (const Rectangle& r : written) H.block(r.row, r.col, r.rows, r.cols).setZero();
   }
-  written = structure;
+  written_known = reused;
+  if (reused) {
+    if (!structure_found) FindStructure();
+    structure_found = true;
+    written = structure;
+  }
   b.setZero(dense_dim);
   for (EliminatedBlock& block : eliminated) {
     const int n = block.columns.size;

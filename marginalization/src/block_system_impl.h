@@ -125,11 +125,13 @@ struct BlockSystem::Impl {
   std::vector<double*> parameter_blocks;  ///< one residual's, while the structure is found
   /// The blocks of H an assembly of this layout can make non-zero (those of
   /// two dense blocks one residual or one eliminated block's Schur update
-  /// couples, and the diagonal ones): found with the structure.
+  /// couples, and the diagonal ones); found when H is first reused.
   std::vector<Rectangle> structure;
-  /// The blocks the last assembly may have written: all of H's upper triangle
-  /// outside them is zero, so Zero() clears only them.
+  bool structure_found = false;
+  /// The blocks the last assembly may have written, when `written_known`: all
+  /// of H's upper triangle outside them is zero, so Zero() clears only them.
   std::vector<Rectangle> written;
+  bool written_known = false;
   // Buffers reused by every Reduce().
   Eigen::MatrixXd H;
   Eigen::VectorXd b;

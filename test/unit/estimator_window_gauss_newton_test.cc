@@ -170,6 +170,7 @@ TEST(WindowGaussNewton, ARelayoutOntoFewerCouplingsLeavesNothingOfTheFirstSystem
   GaussNewtonSolver solver(&problem, all);
   ReducedSystem first;
   ASSERT_TRUE(solver.Reduce(&first));
+  ASSERT_TRUE(solver.Reduce(&first));  // H reused: from here on only the written blocks are cleared
   solver.Relayout(stereo_only);
   ReducedSystem relaid;
   ASSERT_TRUE(solver.Reduce(&relaid));
