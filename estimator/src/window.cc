@@ -239,7 +239,8 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   std::vector<double*> blocks = Blocks(state_ids, landmark_ids);
   if (blocks.empty()) return;
   marginalization::MarginalizationOptions options;
-  options.residual_order = ResidualOrder();
+  options.residual_order =
+      ResidualOrderOf({state_ids.begin(), state_ids.end()}, {landmark_ids.begin(), landmark_ids.end()});
   if (first_estimates_) {
     options.first_estimate = [this](const double* block) { return first_estimates_->Find(KeyOf(block)); };
   }

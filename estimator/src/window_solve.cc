@@ -1,7 +1,10 @@
 // Window's second operation, Gauss-Newton steps (paper §2.2): the column
 // layout by ids, the exact GN path (gauss_newton.h) and the Levenberg-Marquardt
 // path through ceres::Solve with id-ordered elimination groups.
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <memory>
 #include <set>
 #include <stdexcept>
@@ -27,6 +30,37 @@ std::vector<ceres::ResidualBlockId> Window::ResidualOrder() const {
   for (const auto& [to, edge] : imu_edges_) order.push_back(edge.residual);
   for (const auto& [key, observation] : observations_) order.push_back(observation.residual);
   CHECK_EQ(static_cast<int>(order.size()), problem_->NumResidualBlocks()) << "a residual block the window does not know";
+  return order;
+}
+
+// ResidualOrder() restricted to the residuals of the given states and
+// landmarks, without walking every observation: a state's observations are
+// one range of the map (keyed by state first), a landmark's are listed by it.
+std::vector<ceres::ResidualBlockId> Window::ResidualOrderOf(const std::set<StateId>& state_ids,
+                                                            const std::set<LandmarkId>& landmark_ids) const {
+  std::set<const double*> blocks;
+  for (StateId id : state_ids) blocks.insert({states_.at(id).pose, states_.at(id).speed_bias});
+  for (LandmarkId id : landmark_ids) blocks.insert(landmarks_.at(id).p_w);
+  std::vector<ceres::ResidualBlockId> order;
+  for (const Prior& prior : priors_) {
+    const bool touches = std::any_of(prior.blocks.begin(), prior.blocks.end(),
+                                     [&](const double* block) { return blocks.count(block) > 0; });
+    if (touches) order.push_back(prior.residual);
+  }
+  for (const auto& [to, edge] : imu_edges_) {
+    if (state_ids.count(edge.from) || state_ids.count(to)) order.push_back(edge.residual);
+  }
+  std::set<ObservationKey> keys;
+  for (StateId id : state_ids) {
+    for (auto it = observations_.lower_bound({id, LandmarkId(std::numeric_limits<std::int64_t>::min())});
+         it != observations_.end() && it->first.first == id; ++it) {
+      keys.insert(it->first);
+    }
+  }
+  for (LandmarkId id : landmark_ids) {
+    for (StateId from : landmarks_.at(id).observed_from) keys.insert({from, id});
+  }
+  for (const ObservationKey& key : keys) order.push_back(observations_.at(key).residual);
   return order;
 }
 

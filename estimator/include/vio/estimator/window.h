@@ -195,6 +195,8 @@ class Window {
   /// Every residual block: priors in creation order, IMU factors and
   /// observations by ids (never by address).
   std::vector<ceres::ResidualBlockId> ResidualOrder() const;
+  std::vector<ceres::ResidualBlockId> ResidualOrderOf(const std::set<StateId>& state_ids,
+                                                      const std::set<LandmarkId>& landmark_ids) const;
   std::shared_ptr<ceres::ParameterBlockOrdering> SchurOrdering() const;
   std::shared_ptr<ceres::ParameterBlockOrdering> StatesFirstOrdering() const;
   void ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const;
