@@ -267,23 +267,17 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
 // Drops the bookkeeping of every residual that touches a removed block; the
 // residual blocks themselves go with their parameter blocks.
 void Window::ForgetResidualsOf(const std::set<const double*>& removed) {
-  // The observations of a removed state are one range of the map (keyed by
-  // state first); those of a removed landmark are listed by the landmark.
-  const auto forget = [this](const ObservationKey& key) {
+  std::set<StateId> state_ids;
+  std::set<LandmarkId> landmark_ids;
+  for (const auto& [id, state] : states_) {
+    if (removed.count(state.pose)) state_ids.insert(id);
+  }
+  for (const auto& [id, landmark] : landmarks_) {
+    if (removed.count(landmark.p_w)) landmark_ids.insert(id);
+  }
+  for (const ObservationKey& key : ObservationKeysOf(state_ids, landmark_ids)) {
     landmarks_.at(key.second).observed_from.erase(key.first);
     observations_.erase(key);
-  };
-  for (const auto& [state_id, state] : states_) {
-    if (!removed.count(state.pose)) continue;
-    const auto first = observations_.lower_bound({state_id, LandmarkId(std::numeric_limits<int64_t>::min())});
-    std::vector<ObservationKey> keys;
-    for (auto it = first; it != observations_.end() && it->first.first == state_id; ++it) keys.push_back(it->first);
-    for (const ObservationKey& key : keys) forget(key);
-  }
-  for (auto& [landmark_id, landmark] : landmarks_) {
-    if (!removed.count(landmark.p_w)) continue;
-    const std::vector<StateId> from(landmark.observed_from.begin(), landmark.observed_from.end());
-    for (StateId state_id : from) forget({state_id, landmark_id});
   }
   for (auto it = imu_edges_.begin(); it != imu_edges_.end();) {
     const bool gone = removed.count(states_.at(it->second.from).pose) || removed.count(states_.at(it->first).pose);

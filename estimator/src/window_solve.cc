@@ -33,9 +33,26 @@ std::vector<ceres::ResidualBlockId> Window::ResidualOrder() const {
   return order;
 }
 
+// The observations of the given states and landmarks, in the map's order,
+// without walking every observation: a state's are one range of the map
+// (keyed by state first), a landmark's are listed by it.
+std::set<Window::ObservationKey> Window::ObservationKeysOf(const std::set<StateId>& state_ids,
+                                                          const std::set<LandmarkId>& landmark_ids) const {
+  std::set<ObservationKey> keys;
+  for (StateId id : state_ids) {
+    for (auto it = observations_.lower_bound({id, LandmarkId(std::numeric_limits<std::int64_t>::min())});
+         it != observations_.end() && it->first.first == id; ++it) {
+      keys.insert(it->first);
+    }
+  }
+  for (LandmarkId id : landmark_ids) {
+    for (StateId from : landmarks_.at(id).observed_from) keys.insert({from, id});
+  }
+  return keys;
+}
+
 // ResidualOrder() restricted to the residuals of the given states and
-// landmarks, without walking every observation: a state's observations are
-// one range of the map (keyed by state first), a landmark's are listed by it.
+// landmarks.
 std::vector<ceres::ResidualBlockId> Window::ResidualOrderOf(const std::set<StateId>& state_ids,
                                                             const std::set<LandmarkId>& landmark_ids) const {
   std::set<const double*> blocks;
@@ -50,16 +67,7 @@ std::vector<ceres::ResidualBlockId> Window::ResidualOrderOf(const std::set<State
   for (const auto& [to, edge] : imu_edges_) {
     if (state_ids.count(edge.from) || state_ids.count(to)) order.push_back(edge.residual);
   }
-  std::set<ObservationKey> keys;
-  for (StateId id : state_ids) {
-    for (auto it = observations_.lower_bound({id, LandmarkId(std::numeric_limits<std::int64_t>::min())});
-         it != observations_.end() && it->first.first == id; ++it) {
-      keys.insert(it->first);
-    }
-  }
-  for (LandmarkId id : landmark_ids) {
-    for (StateId from : landmarks_.at(id).observed_from) keys.insert({from, id});
-  }
+  const std::set<ObservationKey> keys = ObservationKeysOf(state_ids, landmark_ids);
   for (const ObservationKey& key : keys) order.push_back(observations_.at(key).residual);
   return order;
 }

@@ -197,6 +197,8 @@ class Window {
   std::vector<ceres::ResidualBlockId> ResidualOrder() const;
   std::vector<ceres::ResidualBlockId> ResidualOrderOf(const std::set<StateId>& state_ids,
                                                       const std::set<LandmarkId>& landmark_ids) const;
+  std::set<ObservationKey> ObservationKeysOf(const std::set<StateId>& state_ids,
+                                             const std::set<LandmarkId>& landmark_ids) const;
   std::shared_ptr<ceres::ParameterBlockOrdering> SchurOrdering() const;
   std::shared_ptr<ceres::ParameterBlockOrdering> StatesFirstOrdering() const;
   void ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const;
