@@ -238,14 +238,13 @@ int Window::RefreshImuFactors(double gyro_bias_threshold) {
 void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vector<LandmarkId>& landmark_ids) {
   std::vector<double*> blocks = Blocks(state_ids, landmark_ids);
   if (blocks.empty()) return;
+  const Leaving leaving = LeavingOf(state_ids, landmark_ids);
   marginalization::MarginalizationOptions options;
-  options.residual_order =
-      ResidualOrderOf({state_ids.begin(), state_ids.end()}, {landmark_ids.begin(), landmark_ids.end()});
+  options.residual_order = ResidualOrderOf(leaving);
   if (first_estimates_) {
     options.first_estimate = [this](const double* block) { return first_estimates_->Find(KeyOf(block)); };
   }
-  std::set<const double*> removed(blocks.begin(), blocks.end());
-  ForgetResidualsOf(removed);
+  ForgetResidualsOf(leaving);
   const std::set<ceres::ResidualBlockId> dropped = DropUnevaluableResiduals(blocks);
   auto& order = options.residual_order;
   order.erase(std::remove_if(order.begin(), order.end(), [&](ceres::ResidualBlockId id) { return dropped.count(id) > 0; }),
@@ -264,29 +263,23 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
                                           landmark_ids.end());
 }
 
-// Drops the bookkeeping of every residual that touches a removed block; the
-// residual blocks themselves go with their parameter blocks.
-void Window::ForgetResidualsOf(const std::set<const double*>& removed) {
-  std::set<StateId> state_ids;
-  std::set<LandmarkId> landmark_ids;
-  for (const auto& [id, state] : states_) {
-    if (removed.count(state.pose)) state_ids.insert(id);
-  }
-  for (const auto& [id, landmark] : landmarks_) {
-    if (removed.count(landmark.p_w)) landmark_ids.insert(id);
-  }
-  for (const ObservationKey& key : ObservationKeysOf(state_ids, landmark_ids)) {
+Window::Leaving Window::LeavingOf(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks) {
+  const std::vector<double*> blocks = Blocks(states, landmarks);
+  return {{states.begin(), states.end()}, {landmarks.begin(), landmarks.end()}, {blocks.begin(), blocks.end()}};
+}
+
+// Drops the bookkeeping of every residual of what leaves; the residual blocks
+// themselves go with their parameter blocks.
+void Window::ForgetResidualsOf(const Leaving& leaving) {
+  for (const ObservationKey& key : ObservationKeysOf(leaving)) {
     landmarks_.at(key.second).observed_from.erase(key.first);
     observations_.erase(key);
   }
   for (auto it = imu_edges_.begin(); it != imu_edges_.end();) {
-    const bool gone = removed.count(states_.at(it->second.from).pose) || removed.count(states_.at(it->first).pose);
-    it = gone ? imu_edges_.erase(it) : std::next(it);
+    it = Touches(it->first, it->second, leaving) ? imu_edges_.erase(it) : std::next(it);
   }
   for (auto it = priors_.begin(); it != priors_.end();) {
-    bool gone = false;
-    for (const double* b : it->blocks) gone = gone || removed.count(b) > 0;
-    it = gone ? priors_.erase(it) : std::next(it);
+    it = Touches(*it, leaving) ? priors_.erase(it) : std::next(it);
   }
 }
 
@@ -343,8 +336,7 @@ void Window::DropObservation(StateId state_id, LandmarkId landmark_id) {
 void Window::DropLandmark(LandmarkId landmark_id) {
   auto it = landmarks_.find(landmark_id);
   CHECK(it != landmarks_.end()) << "dropping unknown landmark " << landmark_id.value;
-  std::set<const double*> removed{it->second.p_w};
-  ForgetResidualsOf(removed);
+  ForgetResidualsOf(LeavingOf({}, {landmark_id}));
   problem_->RemoveParameterBlock(it->second.p_w);
   landmarks_.erase(landmark_id);
   removals_.dropped_landmarks.push_back(landmark_id);

@@ -33,42 +33,40 @@ std::vector<ceres::ResidualBlockId> Window::ResidualOrder() const {
   return order;
 }
 
-// The observations of the given states and landmarks, in the map's order,
-// without walking every observation: a state's are one range of the map
-// (keyed by state first), a landmark's are listed by it.
-std::set<Window::ObservationKey> Window::ObservationKeysOf(const std::set<StateId>& state_ids,
-                                                          const std::set<LandmarkId>& landmark_ids) const {
+// A state's observations are one range of the map (keyed by state first), a
+// landmark's are listed by it: no walk over every observation.
+std::set<Window::ObservationKey> Window::ObservationKeysOf(const Leaving& leaving) const {
   std::set<ObservationKey> keys;
-  for (StateId id : state_ids) {
+  for (StateId id : leaving.states) {
     for (auto it = observations_.lower_bound({id, LandmarkId(std::numeric_limits<std::int64_t>::min())});
          it != observations_.end() && it->first.first == id; ++it) {
       keys.insert(it->first);
     }
   }
-  for (LandmarkId id : landmark_ids) {
+  for (LandmarkId id : leaving.landmarks) {
     for (StateId from : landmarks_.at(id).observed_from) keys.insert({from, id});
   }
   return keys;
 }
 
-// ResidualOrder() restricted to the residuals of the given states and
-// landmarks.
-std::vector<ceres::ResidualBlockId> Window::ResidualOrderOf(const std::set<StateId>& state_ids,
-                                                            const std::set<LandmarkId>& landmark_ids) const {
-  std::set<const double*> blocks;
-  for (StateId id : state_ids) blocks.insert({states_.at(id).pose, states_.at(id).speed_bias});
-  for (LandmarkId id : landmark_ids) blocks.insert(landmarks_.at(id).p_w);
+bool Window::Touches(const Prior& prior, const Leaving& leaving) const {
+  return std::any_of(prior.blocks.begin(), prior.blocks.end(),
+                     [&](const double* block) { return leaving.blocks.count(block) > 0; });
+}
+
+bool Window::Touches(StateId to, const ImuEdge& edge, const Leaving& leaving) const {
+  return leaving.states.count(edge.from) > 0 || leaving.states.count(to) > 0;
+}
+
+std::vector<ceres::ResidualBlockId> Window::ResidualOrderOf(const Leaving& leaving) const {
   std::vector<ceres::ResidualBlockId> order;
   for (const Prior& prior : priors_) {
-    const bool touches = std::any_of(prior.blocks.begin(), prior.blocks.end(),
-                                     [&](const double* block) { return blocks.count(block) > 0; });
-    if (touches) order.push_back(prior.residual);
+    if (Touches(prior, leaving)) order.push_back(prior.residual);
   }
   for (const auto& [to, edge] : imu_edges_) {
-    if (state_ids.count(edge.from) || state_ids.count(to)) order.push_back(edge.residual);
+    if (Touches(to, edge, leaving)) order.push_back(edge.residual);
   }
-  const std::set<ObservationKey> keys = ObservationKeysOf(state_ids, landmark_ids);
-  for (const ObservationKey& key : keys) order.push_back(observations_.at(key).residual);
+  for (const ObservationKey& key : ObservationKeysOf(leaving)) order.push_back(observations_.at(key).residual);
   return order;
 }
 

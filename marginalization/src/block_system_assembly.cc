@@ -1,7 +1,9 @@
 #include "block_system_impl.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 #include <glog/logging.h>
 
@@ -221,6 +223,77 @@ bool BlockSystem::Impl::AddPrior(const Residual& residual, double* cost) {
     }
   }
   return true;
+}
+
+// The dense block pairs an assembly writes, as rectangles of H's upper block
+// triangle (runs of adjacent blocks merged): a residual's pairs (a prior's
+// too), the diagonal blocks, and for each eliminated block every pair over
+// the span of its coupled blocks (its Schur update goes over that span, whose
+// gap rows of U are zero; pair by pair it writes fewer). A superset is safe:
+// the blocks are cleared, not assumed non-zero.
+void BlockSystem::Impl::FindStructure() {
+  const size_t m = dense.size();
+  std::vector<char> coupled(m * m, 0);
+  const auto pair = [&](int a, int c) { coupled[static_cast<size_t>(std::min(a, c)) * m + std::max(a, c)] = 1; };
+  std::vector<int> reach(m);  // row block a: every column block up to reach[a] is written
+  for (size_t a = 0; a < m; ++a) reach[a] = static_cast<int>(a);
+  for (const Residual& residual : residuals) {
+    for (const Slot& i : residual.slots) {
+      if (i.dense < 0) continue;
+      for (const Slot& j : residual.slots) {
+        if (j.dense >= 0) pair(i.dense, j.dense);
+      }
+    }
+  }
+  for (const EliminatedBlock& block : eliminated) {
+    if (block.coupled.empty()) continue;
+    for (int a = block.coupled.front(); a <= block.coupled.back(); ++a) {
+      reach[a] = std::max(reach[a], block.coupled.back());
+    }
+  }
+  structure.clear();
+  for (size_t a = 0; a < m; ++a) {
+    for (size_t c = a; c < m; ++c) {
+      if (!coupled[a * m + c] && static_cast<int>(c) > reach[a]) continue;
+      const bool extends = !structure.empty() && structure.back().row == dense[a].offset &&
+                           structure.back().col + structure.back().cols == dense[c].offset;
+      if (extends) {
+        structure.back().cols += dense[c].size;
+      } else {
+        structure.push_back({dense[a].offset, dense[c].offset, dense[a].size, dense[c].size});
+      }
+    }
+  }
+}
+
+// Only H's upper triangle is read (the chain and dense solves, the rank
+// updates); the diagonal blocks are written whole, so they are zeroed whole.
+// When H is reused (a window's solver, step after step and frame after
+// frame), H is already zero outside the blocks the last assembly wrote: only
+// those are cleared. A system assembled once (a marginalization's) never
+// finds its structure.
+void BlockSystem::Impl::Zero() {
+  const bool reused = H.rows() == dense_dim && H.cols() == dense_dim;  // not new, not moved out (MoveReducedTo)
+  if (reused && written_known) {
+    for (const Rectangle& r : written) H.block(r.row, r.col, r.rows, r.cols).setZero();
+  } else {
+    H.resize(dense_dim, dense_dim);
+    H.triangularView<Eigen::Upper>().setZero();
+    for (const Columns& c : dense) H.block(c.offset, c.offset, c.size, c.size).setZero();
+  }
+  written_known = reused;
+  if (reused) {
+    if (!structure_found) FindStructure();
+    structure_found = true;
+    written = structure;
+  }
+  b.setZero(dense_dim);
+  for (EliminatedBlock& block : eliminated) {
+    const int n = block.columns.size;
+    block.H.setZero(n, n);
+    block.b.setZero(n);
+    for (size_t k = 0; k < block.coupled.size(); ++k) block.W[k].setZero(dense[block.coupled[k]].size, n);
+  }
 }
 
 // Every Jacobian entry enters, squared, a diagonal entry of H or of an

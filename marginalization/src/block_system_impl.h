@@ -157,8 +157,6 @@ struct BlockSystem::Impl {
   Impl(ceres::Problem* p, BlockLayout l, const RankThreshold& t);
   void Build(BlockLayout l);
   std::pair<size_t, size_t> AddResidual(ceres::ResidualBlockId id, const std::unordered_map<const double*, Slot>& index);
-  void FindStructure();
-  void Zero();
   void Eliminate();
   void StackCouplings(const EliminatedBlock& block, int first, int rows);
   void SubtractPackedUpdate(const EliminatedBlock& block, const Eigen::VectorXd& c);
@@ -169,7 +167,8 @@ struct BlockSystem::Impl {
   bool Cost(double* cost);
   int CouplingBandwidth(const std::vector<int>& position) const;
 
-  // block_system_assembly.cc: the normal equations at the current values.
+  // block_system_assembly.cc: the normal equations at the current values (and
+  // the blocks of H an assembly writes, cleared before the next).
   template <typename JacobianI, typename JacobianJ>
   void AddDensePair(const Slot& i, const Slot& j, const JacobianI& Ji, const JacobianJ& Jj);
   template <typename Product>
@@ -181,6 +180,8 @@ struct BlockSystem::Impl {
   template <typename Residuals, typename WithJacobian>
   void Accumulate(const Residual& residual, const Residuals& res, const WithJacobian& with_jacobian);
   bool AddPrior(const Residual& residual, double* cost);
+  void FindStructure();
+  void Zero();
   bool AssembledFinite() const;
   bool Assemble(double* cost);
 };

@@ -184,6 +184,13 @@ class Window {
     std::vector<const double*> blocks;
   };
   using ObservationKey = std::pair<StateId, LandmarkId>;
+  /// States and landmarks leaving the window (marginalized or dropped), and
+  /// their parameter blocks.
+  struct Leaving {
+    std::set<StateId> states;
+    std::set<LandmarkId> landmarks;
+    std::set<const double*> blocks;
+  };
 
   void AddImuResidual(ImuEdge& edge);
   ceres::CostFunction* Wrap(ceres::CostFunction* factor) const { return wrapper_ ? wrapper_(factor) : factor; }
@@ -195,14 +202,17 @@ class Window {
   /// Every residual block: priors in creation order, IMU factors and
   /// observations by ids (never by address).
   std::vector<ceres::ResidualBlockId> ResidualOrder() const;
-  std::vector<ceres::ResidualBlockId> ResidualOrderOf(const std::set<StateId>& state_ids,
-                                                      const std::set<LandmarkId>& landmark_ids) const;
-  std::set<ObservationKey> ObservationKeysOf(const std::set<StateId>& state_ids,
-                                             const std::set<LandmarkId>& landmark_ids) const;
+  Leaving LeavingOf(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks);
+  /// ResidualOrder() restricted to the residuals of what leaves.
+  std::vector<ceres::ResidualBlockId> ResidualOrderOf(const Leaving& leaving) const;
+  /// The observations of what leaves, in the map's order.
+  std::set<ObservationKey> ObservationKeysOf(const Leaving& leaving) const;
+  bool Touches(const Prior& prior, const Leaving& leaving) const;
+  bool Touches(StateId to, const ImuEdge& edge, const Leaving& leaving) const;
   std::shared_ptr<ceres::ParameterBlockOrdering> SchurOrdering() const;
   std::shared_ptr<ceres::ParameterBlockOrdering> StatesFirstOrdering() const;
   void ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const;
-  void ForgetResidualsOf(const std::set<const double*>& removed_blocks);
+  void ForgetResidualsOf(const Leaving& leaving);
   std::set<ceres::ResidualBlockId> DropUnevaluableResiduals(const std::vector<double*>& blocks);
   /// The observations whose residual does not evaluate (finitely) at the current values, by ids.
   std::vector<ObservationKey> UnevaluableObservations() const;
