@@ -1,11 +1,13 @@
 #include "vio/frontend/brisk_frontend.h"
 
 #include <algorithm>
+#include <limits>
 #include <unordered_map>
 #include <unordered_set>
 
 #include <glog/logging.h>
 
+#include "vio/estimator/stereo_geometry.h"
 #include "vio/frontend/segment_test_corners.h"
 
 namespace vio::frontend {
@@ -53,13 +55,16 @@ std::vector<FrameFeature> BriskFrontend::TrackFrame(const cv::Mat& left, const c
   AddTime(&StageTimes::stereo_ms, start);
   start = NowNs();
   MatchTemporal(&current);
+  const std::set<LandmarkId> reidentified = Reidentify(prior, &current);
   AddTime(&StageTimes::temporal_ms, start);
   for (FrameFeature& f : current.features) {
     if (!f.tracked) f.id = NewTrack();
   }
   std::vector<FrameFeature> features = current.features;
   const std::vector<LandmarkId> rejected = RejectOutliers(prior, &features);
-  Remember(current, rejected);
+  CountReidentified(std::count_if(features.begin(), features.end(),
+                                  [&](const FrameFeature& f) { return reidentified.count(f.id) > 0; }));
+  Remember(current, rejected, prior);
   return features;
 }
 
@@ -181,8 +186,67 @@ void BriskFrontend::MatchTemporal(StereoFeatures* current) const {
   }
 }
 
-// The frame, without its rejected matches, joins the history.
-void BriskFrontend::Remember(const StereoFeatures& current, const std::vector<LandmarkId>& rejected) {
+std::set<LandmarkId> BriskFrontend::Reidentify(const FramePrior& prior, StereoFeatures* current) const {
+  const double radius = options().reidentify_radius_px;
+  std::set<LandmarkId> given;
+  if (radius <= 0.0 || !prior.T_w_b || prior.landmarks == nullptr) return given;
+  std::set<LandmarkId> recent;  // matched now or tracked in the history: not lost
+  for (const FrameFeature& f : current->features) {
+    if (f.tracked) recent.insert(f.id);
+  }
+  for (const StereoFeatures& past : history_) {
+    for (const FrameFeature& f : past.features) recent.insert(f.id);
+  }
+  const RectifiedStereo& stereo = rectifier().rectified();
+  const Eigen::Isometry3d T_cl_w = (*prior.T_w_b * stereo.T_b_cl).inverse();
+  struct Lost {
+    LandmarkId id;
+    Eigen::Vector3d z_pred;  // rectified (u_L, u_R, v) in the predicted camera [px]
+    const Descriptors* descriptors;
+  };
+  std::vector<Lost> lost;
+  for (const auto& [id, descriptors] : remembered_) {
+    const auto it = prior.landmarks->find(id);
+    if (recent.count(id) > 0 || it == prior.landmarks->end()) continue;
+    const Eigen::Vector3d p_cl = T_cl_w * it->second.position();
+    if (p_cl.z() > 0.0) lost.push_back({id, ProjectRectified(p_cl, stereo), &descriptors});
+  }
+  // Gated pairs by summed Hamming distance; mutual nearest among them.
+  constexpr int kNone = std::numeric_limits<int>::max();
+  std::vector<int> feature_best(current->features.size(), kNone), lost_best(lost.size(), kNone);
+  std::vector<int> feature_match(current->features.size(), -1), lost_match(lost.size(), -1);
+  const int max_bits = options().max_hamming_bits;
+  for (size_t i = 0; i < current->features.size(); ++i) {
+    const FrameFeature& f = current->features[i];
+    if (f.tracked) continue;
+    for (size_t j = 0; j < lost.size(); ++j) {
+      if ((f.z_px - lost[j].z_pred).cwiseAbs().maxCoeff() > radius) continue;
+      const int left_bits = static_cast<int>(
+          cv::norm(current->left_descriptors.row(static_cast<int>(i)), lost[j].descriptors->left, cv::NORM_HAMMING));
+      const int right_bits = static_cast<int>(cv::norm(current->right_descriptors.row(static_cast<int>(i)),
+                                                       lost[j].descriptors->right, cv::NORM_HAMMING));
+      if (left_bits > max_bits || right_bits > max_bits) continue;
+      const int bits = left_bits + right_bits;
+      if (bits < feature_best[i]) feature_best[i] = bits, feature_match[i] = static_cast<int>(j);
+      if (bits < lost_best[j]) lost_best[j] = bits, lost_match[j] = static_cast<int>(i);
+    }
+  }
+  for (size_t i = 0; i < current->features.size(); ++i) {
+    const int j = feature_match[i];
+    if (j < 0 || lost_match[static_cast<size_t>(j)] != static_cast<int>(i)) continue;
+    FrameFeature& f = current->features[i];
+    f.id = lost[static_cast<size_t>(j)].id;
+    f.tracked = true;
+    given.insert(f.id);
+  }
+  return given;
+}
+
+// The frame, without its rejected matches, joins the history; with
+// re-identification on, its features' descriptors replace the remembered
+// ones, and only the landmarks the estimator holds or the history saw stay.
+void BriskFrontend::Remember(const StereoFeatures& current, const std::vector<LandmarkId>& rejected,
+                             const FramePrior& prior) {
   const std::unordered_set<std::int64_t> dropped = [&] {
     std::unordered_set<std::int64_t> ids;
     for (LandmarkId id : rejected) ids.insert(id.value);
@@ -198,6 +262,21 @@ void BriskFrontend::Remember(const StereoFeatures& current, const std::vector<La
   }
   history_.push_front(std::move(kept));
   while (history_.size() > static_cast<size_t>(options().track_window_frames)) history_.pop_back();
+  if (options().reidentify_radius_px <= 0.0) return;
+  const StereoFeatures& newest = history_.front();
+  for (size_t i = 0; i < newest.features.size(); ++i) {
+    const int row = static_cast<int>(i);
+    remembered_[newest.features[i].id] = {newest.left_descriptors.row(row).clone(),
+                                          newest.right_descriptors.row(row).clone()};
+  }
+  std::set<LandmarkId> recent;
+  for (const StereoFeatures& past : history_) {
+    for (const FrameFeature& f : past.features) recent.insert(f.id);
+  }
+  for (auto it = remembered_.begin(); it != remembered_.end();) {
+    const bool held = prior.landmarks != nullptr && prior.landmarks->count(it->first) > 0;
+    it = held || recent.count(it->first) > 0 ? std::next(it) : remembered_.erase(it);
+  }
 }
 
 }  // namespace vio::frontend

@@ -33,6 +33,7 @@ void CheckOptions(const FrontendOptions& o) {
   Require(o.brisk_max_disparity_px > 0, "brisk_max_disparity_px must be > 0");
   Require(o.max_hamming_bits > 0 && o.max_hamming_bits <= 512, "max_hamming_bits must be in (0, 512]");
   Require(o.track_window_frames >= 1, "track_window_frames must be >= 1");
+  Require(o.reidentify_radius_px >= 0, "reidentify_radius_px must be >= 0");
   Require(o.klt_per_cell > 0, "klt_per_cell must be > 0");
   Require(o.klt_fast_threshold > 0, "klt_fast_threshold must be > 0");
   Require(o.klt_min_distance_px >= 0, "klt_min_distance_px must be >= 0");

@@ -2,6 +2,7 @@
 // fronto-parallel plane: a pinhole pair without distortion whose right image
 // is the left one shifted by the plane's disparity, so the true rectified
 // measurement of every feature is known.
+#include <algorithm>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -9,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "vio/estimator/stereo_geometry.h"
 #include "vio/frontend/stereo_frontend.h"
 #include "vio/frontend/track_drawing.h"
 
@@ -189,6 +191,110 @@ TEST(BriskFrontend, StereoMatchesStopAtTheLargestDisparity) {
   bad.frontend = "brisk";
   bad.brisk_max_disparity_px = 0.0;
   EXPECT_THROW(MakeStereoFrontend(bad, rectifier), std::invalid_argument);
+}
+
+// BRISK re-identification: the camera looks at the plane (frame 0), moves
+// kAwayPx to the side for two frames, longer than the one-frame track window,
+// and comes back (frame 3). What the estimator holds throughout are the
+// landmarks of frame 0, triangulated at the true pose and moved by an offset.
+class BriskReidentifyTest : public ::testing::Test {
+ protected:
+  static constexpr int kAwayPx = 270;
+
+  BriskReidentifyTest() : rectifier_(Pinhole(0.0), Pinhole(kBaselineM)), texture_(Texture(7)) {
+    options_.frontend = "brisk";
+    options_.track_window_frames = 1;
+    options_.reidentify_radius_px = 8.0;
+  }
+
+  FramePrior At(int shift_px) const {
+    FramePrior prior;
+    prior.T_w_b = Eigen::Isometry3d::Identity();
+    prior.T_w_b->translation().x() = shift_px / kFocalPx * kDepthM;
+    prior.landmarks = &held_;
+    return prior;
+  }
+
+  struct Result {
+    std::map<LandmarkId, Eigen::Vector3d> lost;      ///< frame 0's landmarks frames 1-2 did not see: z_px in frame 0
+    std::map<LandmarkId, Eigen::Vector3d> returned;  ///< of those, the ones frame 3 reports: z_px in frame 3
+    std::int64_t reidentified = 0;                   ///< the front end's count
+  };
+
+  /// Frames 0, 1, 2, 3 at shifts 0, kAwayPx, kAwayPx, 0; frame 3 shows `last_texture`.
+  Result Run(const FrontendOptions& options, const Eigen::Vector3d& offset_w_m, const cv::Mat& last_texture) {
+    auto frontend = MakeStereoFrontend(options, rectifier_);
+    const int disparity = static_cast<int>(std::lround(kFocalPx * kBaselineM / kDepthM));
+    held_.clear();
+    const Pair start = View(texture_, 0, disparity);
+    const StereoFrame first = frontend->Process(0, start.left, start.right, At(0));
+    const RectifiedStereo& stereo = rectifier_.rectified();
+    for (const StereoObservation& obs : first.observations) {
+      const std::optional<Eigen::Vector3d> p_cl = TriangulateRectified(obs.z_px, stereo, 1.0);
+      if (!p_cl) continue;
+      const Eigen::Vector3d p_w = stereo.T_b_cl * *p_cl + offset_w_m;  // the body is at the origin
+      Landmark& landmark = held_[obs.landmark];
+      landmark.id = obs.landmark;
+      std::copy(p_w.data(), p_w.data() + 3, landmark.p_w);
+    }
+    const Pair away = View(texture_, kAwayPx, disparity);
+    for (int k = 1; k <= 2; ++k) frontend->Process(k, away.left, away.right, At(kAwayPx));
+    const Pair back = View(last_texture, 0, disparity);
+    const StereoFrame last = frontend->Process(3, back.left, back.right, At(0));
+    Result result;
+    for (const StereoObservation& obs : first.observations) {
+      const std::vector<std::int64_t>& seen = frontend->tracks().FramesOf(obs.landmark);
+      if (std::find_if(seen.begin(), seen.end(), [](std::int64_t k) { return k == 1 || k == 2; }) == seen.end()) {
+        result.lost[obs.landmark] = obs.z_px;
+      }
+    }
+    for (const StereoObservation& obs : last.observations) {
+      if (result.lost.count(obs.landmark) > 0) result.returned[obs.landmark] = obs.z_px;
+    }
+    result.reidentified = frontend->stats().reidentified;
+    return result;
+  }
+
+  FrontendOptions options_;
+  StereoRectifier rectifier_;
+  cv::Mat texture_;
+  std::map<LandmarkId, Landmark> held_;
+};
+
+TEST_F(BriskReidentifyTest, ReturningLandmarksGetTheirIdsBackAtTheirOwnPixels) {
+  const Result result = Run(options_, Eigen::Vector3d::Zero(), texture_);
+  ASSERT_GE(result.lost.size(), 50u);
+  EXPECT_GE(result.returned.size(), result.lost.size() / 2);
+  EXPECT_EQ(result.reidentified, static_cast<std::int64_t>(result.returned.size()));
+  for (const auto& [id, z_px] : result.returned) {
+    EXPECT_LT((z_px - result.lost.at(id)).cwiseAbs().maxCoeff(), 1.5) << "landmark " << id.value;
+  }
+  FrontendOptions off = options_;
+  off.reidentify_radius_px = 0.0;
+  const Result without = Run(off, Eigen::Vector3d::Zero(), texture_);
+  EXPECT_EQ(without.lost.size(), result.lost.size());
+  EXPECT_TRUE(without.returned.empty());
+  EXPECT_EQ(without.reidentified, 0);
+}
+
+// No id is given outside the gate: not when every held landmark is predicted
+// 22 px from where it is (the radius gate; the reprojection check, which would
+// also reject those matches, is widened out of the way), nor when the scene at
+// the predicted pixels is another one (the descriptor gate).
+TEST_F(BriskReidentifyTest, AFalseRematchIsRejectedByTheGate) {
+  FrontendOptions wide = options_;
+  wide.max_reprojection_px = 100.0;
+  const Result displaced = Run(wide, Eigen::Vector3d(0.1, 0.0, 0.0), texture_);
+  ASSERT_GE(displaced.lost.size(), 50u);
+  EXPECT_TRUE(displaced.returned.empty());
+  EXPECT_EQ(displaced.reidentified, 0);
+  const Result other_scene = Run(options_, Eigen::Vector3d::Zero(), Texture(8));
+  ASSERT_GE(other_scene.lost.size(), 50u);
+  EXPECT_TRUE(other_scene.returned.empty());
+  EXPECT_EQ(other_scene.reidentified, 0);
+  FrontendOptions bad = options_;
+  bad.reidentify_radius_px = -1.0;
+  EXPECT_THROW(MakeStereoFrontend(bad, rectifier_), std::invalid_argument);
 }
 
 TEST(MakeStereoFrontend, RejectsTheFeaturesFrontEnd) {

@@ -188,7 +188,8 @@ std::string ImageFrameSource::ReportJson() const {
      << Number(s.stereo_candidates ? static_cast<double>(s.stereo_inliers) / s.stereo_candidates : 0.0)
      << ", \"stereo_row_difference_median_px\": " << Number(s.MedianRowDifferencePx())
      << ", \"temporal_matches\": " << s.temporal_matches << ", \"rejected_reprojection\": " << s.rejected_reprojection
-     << ", \"new_tracks\": " << s.new_tracks << ", \"track_length\": " << TrackLengthJson(frontend_->tracks())
+     << ", \"new_tracks\": " << s.new_tracks << ", \"reidentified\": " << s.reidentified
+     << ", \"track_length\": " << TrackLengthJson(frontend_->tracks())
      << ", \"stage_ms\": {\"load\": " << Number(load_ms_ / frames) << ", \"detect\": "
      << Number(s.time.detect_ms / frames) << ", \"stereo_match\": " << Number(s.time.stereo_ms / frames)
      << ", \"temporal_match\": " << Number(s.time.temporal_ms / frames) << ", \"reject\": "

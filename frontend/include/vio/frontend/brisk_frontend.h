@@ -20,10 +20,20 @@
 //             right images separately; the four-way check accepts a match
 //             only when the left-left AND right-right matches pick the same
 //             track;
+//   re-identify (reidentify_radius_px > 0) the landmarks the estimator holds
+//             (FramePrior::landmarks) that no recent frame matched, by their
+//             newest left and right descriptors: a stereo feature still
+//             unmatched takes a landmark's id when it lies within the radius
+//             of the landmark's projection into the IMU-predicted camera (in
+//             u_L, u_R and v), both descriptors are within max_hamming_bits,
+//             and feature and landmark are each other's nearest (summed
+//             Hamming distance) among the pairs passing that gate;
 //   reject    matches whose landmark reprojects too far from the IMU-predicted
 //             camera are dropped (StereoFrontend::RejectOutliers);
 //   new       stereo features not matched to a track start new tracks.
 #include <deque>
+#include <map>
+#include <set>
 #include <vector>
 
 #include <opencv2/features2d.hpp>
@@ -63,11 +73,21 @@ class BriskFrontend final : public StereoFrontend {
   MatchCandidates StereoCandidates(const Detections& left, const Detections& right) const;
   StereoFeatures MatchStereo(const Detections& left, const Detections& right, const MatchCandidates& candidates);
   void MatchTemporal(StereoFeatures* current) const;
-  void Remember(const StereoFeatures& current, const std::vector<LandmarkId>& rejected);
+  /// Gives unmatched features the ids of lost landmarks (see above); returns the ids given.
+  std::set<LandmarkId> Reidentify(const FramePrior& prior, StereoFeatures* current) const;
+  void Remember(const StereoFeatures& current, const std::vector<LandmarkId>& rejected, const FramePrior& prior);
+
+  /// The newest left and right descriptors of one landmark.
+  struct Descriptors {
+    cv::Mat left, right;
+  };
 
   cv::Ptr<cv::BRISK> brisk_;
   FeatureGrid grid_;
   std::deque<StereoFeatures> history_;  ///< the last track_window_frames frames, newest first
+  /// Re-identification: the newest descriptors of every landmark the estimator
+  /// holds or a recent frame saw (empty when reidentify_radius_px is 0).
+  std::map<LandmarkId, Descriptors> remembered_;
 };
 
 }  // namespace vio::frontend
