@@ -119,6 +119,9 @@ const std::vector<Subcommand>& Subcommands() {
       {"imagestats", "grey level, contrast, gradient, corner and KLT statistics of stereo image sequences, as a table",
        "vio imagestats --datasets=DIR,... [--max_frames=200] [--config=FILE]", &ImageStatsMain, {"config", "datasets"},
        /*takes_run_config=*/true},
+      {"matchcheck", "a run's front-end matches against the scene of a dataset `vio simulate` made",
+       "vio matchcheck --dataset=DIR --run=RUN_DIR [--max_error_px=3] [--json=FILE]", &MatchCheckMain,
+       {"dataset", "json"}},
   };
   return commands;
 }

@@ -22,7 +22,9 @@ DEFINE_string(groundtruth, "",
 DEFINE_string(alignment, "posyaw", "estimate-to-ground-truth alignment: posyaw|se3|sim3|none");
 DEFINE_string(rpe_lengths, "1,2,5,10",
               "RPE sub-trajectory lengths along the ground truth [m], comma separated");
-DEFINE_string(json, "", "also write the report as JSON to this file (optional; vio verify: its rows)");
+DEFINE_string(json, "",
+              "also write the report as JSON to this file (optional; vio verify: its rows; vio matchcheck: "
+              "default RUN_DIR/match_truth.json)");
 DEFINE_string(covariance, "",
               "covariance.csv of the run (vio run --output_covariance): adds the NEES of position, orientation and "
               "pose, the estimate aligned at its first pose along the directions --alignment frees (optional)");

@@ -10,6 +10,9 @@ DEFINE_string(dataset, "", "EuRoC ASL dataset folder (holding mav0/) with featur
 DEFINE_bool(output_covariance, false,
             "write covariance.csv: per frame, the newest state's marginal covariance (pose 6x6 upper triangle, "
             "velocity and bias variances) from the window's information");
+DEFINE_bool(output_observations, false,
+            "write observations.csv: every stereo observation given to the estimator (timestamp, landmark id, "
+            "rectified u_L, u_R, v), for `vio matchcheck`");
 DEFINE_string(config, "", "run configuration YAML (e.g. config/euroc_stereo.yaml); flags override it");
 
 namespace vio::tools {
@@ -29,6 +32,7 @@ int RunMain(const std::vector<std::string>& args) {
   request.output_dir = FLAGS_output_dir;
   request.config = LoadRunConfig(FLAGS_config);
   request.output_covariance = FLAGS_output_covariance;
+  request.output_observations = FLAGS_output_observations;
   const RunResult result = RunDataset(request);
   std::cout << "status " << result.status << ": " << result.frames_estimated << "/" << result.frames
             << " frames, " << result.ms_per_frame << " ms per frame, " << result.real_time_factor

@@ -18,5 +18,6 @@ int VerifyMain(const std::vector<std::string>& args);
 int SweepMain(const std::vector<std::string>& args);
 int ConvertMain(const std::vector<std::string>& args);
 int ImageStatsMain(const std::vector<std::string>& args);
+int MatchCheckMain(const std::vector<std::string>& args);
 
 }  // namespace vio::tools

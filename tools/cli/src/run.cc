@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 #include <glog/logging.h>
@@ -18,6 +19,7 @@
 #include "vio/cli/progress.h"
 #include "vio/dataset/frame_source.h"
 #include "vio/dataset/groundtruth_init.h"
+#include "vio/dataset/observations_csv.h"
 #include "vio/dataset/rosbag_dataset.h"
 
 namespace vio::tools {
@@ -151,8 +153,9 @@ void CountFrameGaps(const FrameSource& source, RunResult* result) {
 
 // The frame loop: IMU, (ground-truth start), front end, estimator, output.
 // Bad data mid-run ends the loop with a status; what was estimated is kept.
+// `observations` (null: none written) receives every frame the estimator is given.
 void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, FrameSource& source,
-                    Estimator& estimator, RunOutput& output, RunResult* result) {
+                    Estimator& estimator, RunOutput& output, ObservationsCsvWriter* observations, RunResult* result) {
   const auto num_frames = static_cast<std::int64_t>(source.size());
   ProgressBar progress = request.show_progress ? ProgressBar(num_frames, "frames")
                                                : ProgressBar(num_frames, "frames", nullptr, false);
@@ -177,7 +180,9 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
         }
         estimator.SetInitialState(*gt);
       }
-      const FrameEstimate estimate = estimator.ProcessFrame(source.Frame(k, estimator));
+      const StereoFrame frame = source.Frame(k, estimator);
+      if (observations != nullptr) observations->Add(frame);
+      const FrameEstimate estimate = estimator.ProcessFrame(frame);
       progress.Update(static_cast<std::int64_t>(k + 1));
       if (!estimate.initialized) {
         ++result->health.frames_waiting_init;
@@ -312,7 +317,10 @@ RunResult RunDataset(const RunRequest& requested) {
   }
   CountFrameGaps(*source, &result);
   const auto start = std::chrono::steady_clock::now();
-  EstimateFrames(request, dataset, *source, estimator, output, &result);
+  std::optional<ObservationsCsvWriter> observations;
+  if (request.output_observations) observations.emplace(request.output_dir + "/observations.csv");
+  EstimateFrames(request, dataset, *source, estimator, output, observations ? &*observations : nullptr, &result);
+  if (observations) observations->Close();
   result.tracking = estimator.tracking();
   if (result.status == "ok") FinishEstimates(estimator, output, &result);
   ReportFramesOutsideImu(dataset, *source, request.config.estimator.model.max_imu_gap_s, &result);

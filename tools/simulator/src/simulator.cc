@@ -10,6 +10,7 @@
 #include <glog/logging.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "vio/dataset/scene_csv.h"
 
 namespace vio::tools {
 namespace {
@@ -248,6 +249,7 @@ void WriteSimulation(const Simulation& simulation, const SimulatorOptions& optio
                      const RenderProgress& progress) {
   if (options.output_dir.empty()) throw std::invalid_argument("simulator: an output folder is required");
   WriteEuroc(simulation.dataset, options.output_dir);
+  WriteSceneCsv({simulation.scene.room, simulation.scene.boxes}, options.output_dir + "/mav0/scene.csv");
   if (options.camera_output == SimCameraOutput::kImages) WriteImages(simulation, options, progress);
 }
 

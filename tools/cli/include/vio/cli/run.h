@@ -10,6 +10,8 @@
 //   config.yaml     the effective configuration
 //   covariance.csv  with output_covariance: per frame, the newest state's marginal covariance (run_output.h)
 //   nees.csv        with output_covariance and ground truth: per-frame NEES (nees.h), means in summary.json
+//   observations.csv  with output_observations: the stereo observations given to the estimator
+//                   (observations_csv.h; `vio matchcheck` checks them against a rendered dataset's scene)
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +29,7 @@ struct RunRequest {
   RunConfig config;
   bool show_progress = true; ///< progress bar (only drawn on a terminal)
   bool output_covariance = false;  ///< write covariance.csv (one more linearization per frame)
+  bool output_observations = false;  ///< write observations.csv (inside the timed loop: a little slower)
 };
 
 /// What a run could not do or had to reject (summary.json "health").

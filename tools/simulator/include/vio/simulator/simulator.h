@@ -112,7 +112,8 @@ Simulation BuildSimulation(const SimulatorOptions& options);
 /// Told how many of `total` images are written, after each one (images mode).
 using RenderProgress = std::function<void(std::int64_t done, std::int64_t total)>;
 
-/// Writes the ASL folder (WriteEuroc) and, in images mode, renders and
+/// Writes the ASL folder (WriteEuroc), the scene's geometry as mav0/scene.csv
+/// (scene_csv.h) and, in images mode, renders and
 /// writes cam0/cam1 PNGs, calling `progress` (when set) after each image.
 /// Throws std::invalid_argument on an empty output_dir, std::runtime_error
 /// when an image cannot be written.
