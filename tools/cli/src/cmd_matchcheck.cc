@@ -18,8 +18,8 @@ DECLARE_string(dataset);
 DECLARE_string(json);
 DEFINE_string(run, "", "output folder of a `vio run --output_observations` on that dataset (its observations.csv)");
 DEFINE_double(max_error_px, 3.0,
-              "an observation is correct when its landmark's true point projects within this of the measured "
-              "pixel [px] valid: (0, inf)");
+              "an observation is right when the point it sees is within this many pixel footprints of its "
+              "landmark's point, or that point projects within this of its pixel, unhidden [px] valid: (0, inf)");
 
 namespace vio::tools {
 namespace {
