@@ -193,16 +193,26 @@ TEST(BriskFrontend, StereoMatchesStopAtTheLargestDisparity) {
   EXPECT_THROW(MakeStereoFrontend(bad, rectifier), std::invalid_argument);
 }
 
-// BRISK re-identification: the camera looks at the plane (frame 0), moves
-// kAwayPx to the side for two frames, longer than the one-frame track window,
-// and comes back (frame 3). What the estimator holds throughout are the
-// landmarks of frame 0, triangulated at the true pose and moved by an offset.
-class BriskReidentifyTest : public ::testing::Test {
+// Re-identification (BRISK by descriptors, KLT by patch and ZNCC): the camera
+// looks at the plane (frame 0), moves kAwayPx to the side for two frames,
+// longer than BRISK's one-frame track window and far enough that a third of
+// frame 0 leaves the image (KLT follows the rest from the predicted pose), and
+// comes back (frame 3). What the estimator holds are the landmarks of frame
+// 0, triangulated at the true pose; at frame 3 they are moved by an offset
+// (only then: held 22 px off in frames 1-2 with the reprojection check
+// widened, KLT's LK from the predicted pixel follows some of them onto what
+// lies 22 px away, and those tracks would come back consistently).
+// A landmark is lost when no feature of frames 1-2 had it (KLT also keeps
+// tracks that are not stereo, which are no observations), and only frame 3's
+// re-identifications are counted: the plane's integer disparity puts it at
+// 1.98 m rather than 2 m, so frame 1's predictions are 3 px off, and KLT gets
+// back in frame 2 a few of frame 0's landmarks that frame 1 lost.
+class ReidentifyTest : public ::testing::TestWithParam<std::string> {
  protected:
   static constexpr int kAwayPx = 270;
 
-  BriskReidentifyTest() : rectifier_(Pinhole(0.0), Pinhole(kBaselineM)), texture_(Texture(7)) {
-    options_.frontend = "brisk";
+  ReidentifyTest() : rectifier_(Pinhole(0.0), Pinhole(kBaselineM)), texture_(Texture(7)) {
+    options_.frontend = GetParam();
     options_.track_window_frames = 1;
     options_.reidentify_radius_px = 8.0;
   }
@@ -216,43 +226,55 @@ class BriskReidentifyTest : public ::testing::Test {
   }
 
   struct Result {
-    std::map<LandmarkId, Eigen::Vector3d> lost;      ///< frame 0's landmarks frames 1-2 did not see: z_px in frame 0
+    std::map<LandmarkId, Eigen::Vector3d> lost;      ///< frame 0's landmarks frames 1-2 lacked: z_px in frame 0
     std::map<LandmarkId, Eigen::Vector3d> returned;  ///< of those, the ones frame 3 reports: z_px in frame 3
-    std::int64_t reidentified = 0;                   ///< the front end's count
+    std::int64_t reidentified = 0;                   ///< the front end's count at frame 3
   };
 
-  /// Frames 0, 1, 2, 3 at shifts 0, kAwayPx, kAwayPx, 0; frame 3 shows `last_texture`.
-  Result Run(const FrontendOptions& options, const Eigen::Vector3d& offset_w_m, const cv::Mat& last_texture) {
+  /// Frames 0, 1, 2, 3 at shifts 0, kAwayPx, kAwayPx, 0; at frame 3 the held
+  /// landmarks are moved `depth_scale` times as far along their rays of frame
+  /// 0, then by `offset_w_m`, and the images show `last_texture`.
+  Result Run(const FrontendOptions& options, const Eigen::Vector3d& offset_w_m, const cv::Mat& last_texture,
+             double depth_scale = 1.0) {
     auto frontend = MakeStereoFrontend(options, rectifier_);
     const int disparity = static_cast<int>(std::lround(kFocalPx * kBaselineM / kDepthM));
-    held_.clear();
     const Pair start = View(texture_, 0, disparity);
     const StereoFrame first = frontend->Process(0, start.left, start.right, At(0));
-    const RectifiedStereo& stereo = rectifier_.rectified();
-    for (const StereoObservation& obs : first.observations) {
-      const std::optional<Eigen::Vector3d> p_cl = TriangulateRectified(obs.z_px, stereo, 1.0);
-      if (!p_cl) continue;
-      const Eigen::Vector3d p_w = stereo.T_b_cl * *p_cl + offset_w_m;  // the body is at the origin
-      Landmark& landmark = held_[obs.landmark];
-      landmark.id = obs.landmark;
-      std::copy(p_w.data(), p_w.data() + 3, landmark.p_w);
-    }
+    Hold(first, Eigen::Vector3d::Zero());
     const Pair away = View(texture_, kAwayPx, disparity);
-    for (int k = 1; k <= 2; ++k) frontend->Process(k, away.left, away.right, At(kAwayPx));
+    std::set<LandmarkId> seen;  // by a feature of frame 1 or 2, stereo or (KLT) left only
+    for (int k = 1; k <= 2; ++k) {
+      frontend->Process(k, away.left, away.right, At(kAwayPx));
+      for (const FrameFeature& f : frontend->features()) seen.insert(f.id);
+    }
+    Hold(first, offset_w_m, depth_scale);
+    const std::int64_t before = frontend->stats().reidentified;
     const Pair back = View(last_texture, 0, disparity);
     const StereoFrame last = frontend->Process(3, back.left, back.right, At(0));
     Result result;
     for (const StereoObservation& obs : first.observations) {
-      const std::vector<std::int64_t>& seen = frontend->tracks().FramesOf(obs.landmark);
-      if (std::find_if(seen.begin(), seen.end(), [](std::int64_t k) { return k == 1 || k == 2; }) == seen.end()) {
-        result.lost[obs.landmark] = obs.z_px;
-      }
+      if (seen.count(obs.landmark) == 0) result.lost[obs.landmark] = obs.z_px;
     }
     for (const StereoObservation& obs : last.observations) {
       if (result.lost.count(obs.landmark) > 0) result.returned[obs.landmark] = obs.z_px;
     }
-    result.reidentified = frontend->stats().reidentified;
+    result.reidentified = frontend->stats().reidentified - before;
     return result;
+  }
+
+  /// The held landmarks: those of `frame` (the body at the origin), `depth_scale`
+  /// times as far along their rays, moved by `offset_w_m`.
+  void Hold(const StereoFrame& frame, const Eigen::Vector3d& offset_w_m, double depth_scale = 1.0) {
+    held_.clear();
+    const RectifiedStereo& stereo = rectifier_.rectified();
+    for (const StereoObservation& obs : frame.observations) {
+      const std::optional<Eigen::Vector3d> p_cl = TriangulateRectified(obs.z_px, stereo, 1.0);
+      if (!p_cl) continue;
+      const Eigen::Vector3d p_w = stereo.T_b_cl * (depth_scale * *p_cl) + offset_w_m;
+      Landmark& landmark = held_[obs.landmark];
+      landmark.id = obs.landmark;
+      std::copy(p_w.data(), p_w.data() + 3, landmark.p_w);
+    }
   }
 
   FrontendOptions options_;
@@ -261,7 +283,7 @@ class BriskReidentifyTest : public ::testing::Test {
   std::map<LandmarkId, Landmark> held_;
 };
 
-TEST_F(BriskReidentifyTest, ReturningLandmarksGetTheirIdsBackAtTheirOwnPixels) {
+TEST_P(ReidentifyTest, ReturningLandmarksGetTheirIdsBackAtTheirOwnPixels) {
   const Result result = Run(options_, Eigen::Vector3d::Zero(), texture_);
   ASSERT_GE(result.lost.size(), 50u);
   EXPECT_GE(result.returned.size(), result.lost.size() / 2);
@@ -278,10 +300,15 @@ TEST_F(BriskReidentifyTest, ReturningLandmarksGetTheirIdsBackAtTheirOwnPixels) {
 }
 
 // No id is given outside the gate: not when every held landmark is predicted
-// 22 px from where it is (the radius gate; the reprojection check, which would
-// also reject those matches, is widened out of the way), nor when the scene at
-// the predicted pixels is another one (the descriptor gate).
-TEST_F(BriskReidentifyTest, AFalseRematchIsRejectedByTheGate) {
+// 22 px from where it is (the radius gate, and for KLT the ZNCC and uniqueness
+// gates on what the radius holds; the reprojection check, which would also
+// reject those matches, is widened out of the way), nor when the scene at the
+// predicted pixels is another one (the descriptor gate; for KLT the ZNCC and
+// uniqueness gates), nor when the held landmarks are twice as far along their
+// rays: u_L and v are right, u_R is 12 px off (BRISK's radius gate; KLT finds
+// them and matches them in stereo, and the reprojection check rejects them,
+// before they are counted).
+TEST_P(ReidentifyTest, AFalseRematchIsRejectedByTheGate) {
   FrontendOptions wide = options_;
   wide.max_reprojection_px = 100.0;
   const Result displaced = Run(wide, Eigen::Vector3d(0.1, 0.0, 0.0), texture_);
@@ -292,10 +319,78 @@ TEST_F(BriskReidentifyTest, AFalseRematchIsRejectedByTheGate) {
   ASSERT_GE(other_scene.lost.size(), 50u);
   EXPECT_TRUE(other_scene.returned.empty());
   EXPECT_EQ(other_scene.reidentified, 0);
+  const Result deeper = Run(options_, Eigen::Vector3d::Zero(), texture_, 2.0);
+  ASSERT_GE(deeper.lost.size(), 50u);
+  EXPECT_TRUE(deeper.returned.empty());
+  EXPECT_EQ(deeper.reidentified, 0);
   FrontendOptions bad = options_;
   bad.reidentify_radius_px = -1.0;
   EXPECT_THROW(MakeStereoFrontend(bad, rectifier_), std::invalid_argument);
 }
+
+INSTANTIATE_TEST_SUITE_P(BothFrontEnds, ReidentifyTest, ::testing::Values("brisk", "klt"),
+                         [](const auto& info) { return info.param; });
+
+// A texture that repeats every period_px rows: random grey columns, blurred.
+cv::Mat RowPeriodicTexture(int period_px, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> grey(0, 255);
+  cv::Mat rows(period_px, kWidth + 400, CV_8UC1);
+  for (int y = 0; y < rows.rows; ++y) {
+    for (int x = 0; x < rows.cols; ++x) rows.at<uchar>(y, x) = static_cast<uchar>(grey(rng));
+  }
+  cv::Mat texture;
+  cv::repeat(rows, (kHeight + 40) / period_px + 3, 1, texture);
+  cv::GaussianBlur(texture, texture, cv::Size(5, 5), 1.2);
+  return texture(cv::Rect(0, period_px, kWidth + 400, kHeight + 40)).clone();
+}
+
+class KltReidentifyTest : public ReidentifyTest {};
+
+// KLT's uniqueness gate: on a scene that repeats every 7 rows, each lost
+// landmark's patch scores its best ZNCC also 7 px above and below its own
+// pixel, inside the radius; no id is given back (without the gate 105 of the
+// 114 lost landmarks came back, 46 of them a period off in v, which the 8 px
+// reprojection check does not reject).
+TEST_P(KltReidentifyTest, AnAmbiguousRematchIsRejected) {
+  texture_ = RowPeriodicTexture(7, 7);
+  const Result result = Run(options_, Eigen::Vector3d::Zero(), texture_);
+  ASSERT_GE(result.lost.size(), 50u);
+  EXPECT_TRUE(result.returned.empty());
+  EXPECT_EQ(result.reidentified, 0);
+}
+
+// KLT's distance gate: frame 3 comes back with the held landmarks predicted
+// far out of view, so new corners fill the returning part under new ids,
+// many on the lost landmarks' own points; in frame 4, predicted right again,
+// a lost landmark is not given back on top of such a track (features stay
+// klt_min_distance_px apart, up to the rounding of the mask's pixels), and
+// some are given back where no track took their place.
+TEST_P(KltReidentifyTest, ALandmarkIsNotGivenBackWhereATrackIs) {
+  auto frontend = MakeStereoFrontend(options_, rectifier_);
+  const int disparity = static_cast<int>(std::lround(kFocalPx * kBaselineM / kDepthM));
+  const Pair start = View(texture_, 0, disparity), away = View(texture_, kAwayPx, disparity);
+  const StereoFrame first = frontend->Process(0, start.left, start.right, At(0));
+  Hold(first, Eigen::Vector3d::Zero());
+  for (int k = 1; k <= 2; ++k) frontend->Process(k, away.left, away.right, At(kAwayPx));
+  Hold(first, Eigen::Vector3d(50.0, 0.0, 0.0));
+  frontend->Process(3, start.left, start.right, At(0));
+  Hold(first, Eigen::Vector3d::Zero());
+  const std::int64_t before = frontend->stats().reidentified;
+  frontend->Process(4, start.left, start.right, At(0));
+  EXPECT_GT(frontend->stats().reidentified, before);
+  const std::vector<FrameFeature>& features = frontend->features();
+  double closest = 1e9;
+  for (size_t i = 0; i < features.size(); ++i) {
+    for (size_t j = i + 1; j < features.size(); ++j) {
+      closest = std::min(closest, (features[i].uv0_px - features[j].uv0_px).norm());
+    }
+  }
+  EXPECT_GT(closest, options_.klt_min_distance_px - 1.5);
+}
+
+INSTANTIATE_TEST_SUITE_P(Klt, KltReidentifyTest, ::testing::Values("klt"),
+                         [](const auto& info) { return info.param; });
 
 TEST(MakeStereoFrontend, RejectsTheFeaturesFrontEnd) {
   FrontendOptions options;

@@ -30,9 +30,11 @@ struct FrontendOptions {
   int max_hamming_bits = 90;
   /// BRISK: tracks seen in the last this many frames are matched to the new one [frames].
   int track_window_frames = 3;
-  /// BRISK: landmarks the estimator holds (FramePrior::landmarks) but no recent
-  /// frame matched are sought again within this distance of their projection
-  /// into the IMU-predicted camera, in u_L, u_R and v [px]; 0 = off.
+  /// BRISK and KLT: landmarks the estimator holds (FramePrior::landmarks) but
+  /// the front end lost are sought again within this distance of their
+  /// projection into the IMU-predicted camera: BRISK by their descriptors, in
+  /// u_L, u_R and v; KLT by a remembered left-image patch and ZNCC, in the raw
+  /// left image [px]; 0 = off.
   double reidentify_radius_px = 0.0;
   /// KLT: most features per grid cell; new corners fill cells below it [count].
   int klt_per_cell = 4;
@@ -74,8 +76,8 @@ struct FrontendOptions {
     v("track_window_frames", track_window_frames,
       "BRISK matches the new frame to tracks seen in this many previous frames [frames]", AtLeast(1));
     v("reidentify_radius_px", reidentify_radius_px,
-      "BRISK re-identifies landmarks the estimator holds within this distance of their IMU-predicted projection "
-      "(use with persistent_landmarks); 0 = off [px]",
+      "BRISK (by descriptors) and KLT (by a remembered patch and ZNCC) re-identify lost landmarks the estimator "
+      "holds within this distance of their IMU-predicted projection (use with persistent_landmarks); 0 = off [px]",
       AtLeast(0));
     v("klt_per_cell", klt_per_cell, "KLT most features per grid cell [count]", AtLeast(1));
     v("klt_max_features", klt_max_features, "KLT most features in the image [count]", AtLeast(1));

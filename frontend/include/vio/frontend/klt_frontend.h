@@ -24,15 +24,37 @@
 //             becomes a feature only when the row search finds it in the
 //             right image and the stereo LK from there passes both checks,
 //             so every new feature is a stereo observation at once;
+//   re-identify (reidentify_radius_px > 0; after detect's thinning, before
+//             its new corners) the landmarks the estimator holds
+//             (FramePrior::landmarks) that are no current track, by the 21 px
+//             left-image patch remembered around each one's last tracked
+//             pixel: the patch is sought by ZNCC within the radius of the
+//             landmark's projection into the IMU-predicted camera (raw left
+//             pixels, whole-pixel positions, parabola-refined); the best
+//             position is taken when it scores at least 0.9 (and
+//             klt_min_ncc), no position further than 2 px from it scores
+//             within 0.05 of it, and it lies where a new corner may go (at
+//             least klt_min_distance_px from every feature, in a cell below
+//             klt_per_cell); it is then matched in stereo like a new corner
+//             (row search, then LK with both checks), and only a stereo match
+//             becomes a track again, with the landmark's id, checked against
+//             the predicted pose like every temporal match (reject); a
+//             track's patch is cut from the last left image it was tracked in
+//             when it is lost (so a track lost in this frame's temporal step
+//             can be found again at once), and kept while the estimator holds
+//             its landmark and it is no track;
 //   reject    tracked features whose landmark reprojects too far from the
 //             IMU-predicted camera are dropped (StereoFrontend::RejectOutliers).
 // A feature lost in the right image stays tracked in the left one and keeps
 // its id; it is an observation only in the frames where it is stereo, and is
 // dropped after a few frames without a stereo match (its cell is refilled).
+#include <map>
 #include <optional>
+#include <set>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
 #include "vio/frontend/feature_grid.h"
@@ -87,6 +109,9 @@ class KltFrontend final : public StereoFrontend {
   /// Where the track's landmark should appear in the left image, seen from
   /// the predicted pose; nullopt without a prediction or a position.
   std::optional<cv::Point2f> PredictedPixel(LandmarkId id, const FramePrior& prior) const;
+  /// The raw left pixel of a world point seen from the body pose T_w_b;
+  /// nullopt behind the camera or outside the camera model.
+  std::optional<cv::Point2f> LeftPixel(const Eigen::Vector3d& p_w, const Eigen::Isometry3d& T_w_b) const;
   /// Stereo matches of the tracks: from the last disparity, then the row search.
   void MatchTracks(const StereoImages& images);
   /// The row search's disparity of a left pixel (nullopt: none found).
@@ -101,7 +126,25 @@ class KltFrontend final : public StereoFrontend {
   /// features beyond klt_per_cell; returns the mask of where new corners may
   /// go and the count per cell.
   cv::Mat Thin(const cv::Mat& left, std::vector<int>* per_cell);
-  void DetectNew(const StereoImages& images);
+  /// New features from FAST corners where `mask` (from Thin) allows them.
+  void DetectNew(const StereoImages& images, cv::Mat* mask, std::vector<int>* per_cell);
+  /// Lost landmarks found again (see above) become tracks where `mask`
+  /// allows them; returns their ids.
+  std::set<LandmarkId> Reidentify(const StereoImages& images, const FramePrior& prior, cv::Mat* mask,
+                                  std::vector<int>* per_cell);
+  /// The best ZNCC position of `patch` within reidentify_radius_px of
+  /// `predicted` in the left image when it passes the score and uniqueness
+  /// gates; nullopt otherwise.
+  std::optional<cv::Point2f> FindPatch(const cv::Mat& left, const cv::Mat& patch, const cv::Point2f& predicted) const;
+  /// Drops the tracks of the ids RejectOutliers rejected.
+  void DropTracks(const std::vector<LandmarkId>& rejected);
+  /// The tracks of the previous frame that are no tracks now leave their
+  /// patch in the previous left image (remembered_) and previous_tracks_.
+  void RememberLost();
+  /// With re-identification on, at the end of a frame: RememberLost (the
+  /// tracks rejected since), only the lost landmarks the estimator holds stay
+  /// remembered, and the tracks are noted for the next frame.
+  void Remember(const FramePrior& prior);
   /// New-feature candidates: the strongest corners, spread over the cells in
   /// rounds, that the row search finds in the right image.
   std::vector<Track> Candidates(const StereoImages& images, cv::Mat* mask, std::vector<int>* per_cell) const;
@@ -111,6 +154,22 @@ class KltFrontend final : public StereoFrontend {
   StereoRowSearch row_search_;
   std::vector<cv::Mat> previous_left_;  ///< pyramid of the previous left image
   std::vector<Track> tracks_;           ///< features of the left image
+  /// Where a track was in the previous left image.
+  struct Seen {
+    LandmarkId id;
+    cv::Point2f uv0_px;  ///< left image [px]
+    int age = 0;         ///< frames tracked
+  };
+  /// The last appearance of a lost landmark in the left image.
+  struct Appearance {
+    cv::Mat patch;  ///< CV_8UC1 square around the last tracked pixel
+    int age = 0;    ///< frames the track had been tracked
+  };
+  /// Re-identification (both empty when reidentify_radius_px is 0): the
+  /// tracks of the previous frame, and the appearance of every landmark the
+  /// estimator holds that is no track.
+  std::vector<Seen> previous_tracks_;
+  std::map<LandmarkId, Appearance> remembered_;
 };
 
 }  // namespace vio::frontend
