@@ -9,8 +9,12 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "parabola_vertex.h"
+
 namespace vio::frontend {
 namespace {
+
+using detail::ParabolaVertex;
 
 bool Inside(const cv::Point2f& p, const cv::Mat& image) {
   return p.x >= 0 && p.y >= 0 && p.x <= static_cast<float>(image.cols - 1) &&
@@ -72,13 +76,6 @@ constexpr double kMinPatchStdGrey = 2.0;
 /// kUniquenessMargin of it makes the best ambiguous [px], [ZNCC].
 constexpr int kPeakHalfWidthPx = 2;
 constexpr double kUniquenessMargin = 0.05;
-
-// Sub-pixel offset of a peak from the scores before, at and after it.
-double ParabolaVertex(float before, float at, float after) {
-  const double curvature = static_cast<double>(before) - 2.0 * at + after;
-  if (curvature >= 0.0) return 0.0;
-  return 0.5 * (static_cast<double>(before) - after) / curvature;
-}
 
 // Whether a score other than those within kPeakHalfWidthPx of `best` comes
 // within kUniquenessMargin of it.

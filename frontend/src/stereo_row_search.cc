@@ -8,8 +8,12 @@
 #include <glog/logging.h>
 #include <opencv2/imgproc.hpp>
 
+#include "parabola_vertex.h"
+
 namespace vio::frontend {
 namespace {
+
+using detail::ParabolaVertex;
 
 /// A second peak (beyond kPeakHalfWidthPx of the best) scoring within this
 /// much of the best makes the match ambiguous [ZNCC].
@@ -65,13 +69,6 @@ std::vector<float> ZnccAlongStrip(const cv::Mat& strip, const cv::Mat& templ) {
     }
   }
   return scores;
-}
-
-// Sub-pixel offset of a peak from the scores left of, at and right of it.
-double ParabolaVertex(float before, float at, float after) {
-  const double curvature = static_cast<double>(before) - 2.0 * at + after;
-  if (curvature >= 0.0) return 0.0;
-  return 0.5 * (static_cast<double>(before) - after) / curvature;
 }
 
 }  // namespace
