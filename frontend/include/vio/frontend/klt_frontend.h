@@ -112,6 +112,10 @@ class KltFrontend final : public StereoFrontend {
   /// The raw left pixel of a world point seen from the body pose T_w_b;
   /// nullopt behind the camera or outside the camera model.
   std::optional<cv::Point2f> LeftPixel(const Eigen::Vector3d& p_w, const Eigen::Isometry3d& T_w_b) const;
+  /// Whether p lies inside the image (borders included).
+  static bool Inside(const cv::Point2f& p, const cv::Mat& image);
+  /// The ids of the current tracks.
+  std::set<LandmarkId> TrackIds() const;
   /// Stereo matches of the tracks: from the last disparity, then the row search.
   void MatchTracks(const StereoImages& images);
   /// The row search's disparity of a left pixel (nullopt: none found).
