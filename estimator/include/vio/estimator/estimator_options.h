@@ -21,7 +21,9 @@ struct PolicyOptions {
   int keyframe_temporal_window = 3;  ///< keyframe policy: most recent frames always kept [frames]
   double keyframe_overlap = 0.7;     ///< keyframe policy: new keyframe below this shared-landmark fraction []
   /// Frames with fewer stereo observations are tracking loss: not used,
-  /// propagated on the IMU (tracking_monitor.h) [count].
+  /// propagated on the IMU (tracking_monitor.h) [count]. 1: every frame with
+  /// something to track is used (better with exact simulated features, not
+  /// with image front ends: README "Frame gaps and tracking loss").
   int min_frame_features = 10;
 
   template <class V>
