@@ -42,6 +42,7 @@ FrameEstimate Estimator::ProcessFrame(const StereoFrame& frame) {
   const bool tracked = tracking_.Observe(frame.t_ns, static_cast<int>(frame.observations.size()));
   timing.policy = policy_->Update(tracked ? GateObservations(frame) : StereoFrame{frame.t_ns, {}}, last_state_, window_);
   PruneImu(window_.states().begin()->second.t_ns);
+  for (const State& s : window_.removals().leaving_states) left_window_.push_back(EstimateOf(s));
   FrameEstimate estimate = Estimate(frame);
   timing.total_ms = MillisecondsSince(start);
   estimate.timing = timing;
@@ -135,6 +136,12 @@ std::vector<FrameEstimate> Estimator::Finish() {
   if (!last_state_.valid() || !policy_->Finish(window_)) return smoothed;
   for (const auto& [id, s] : window_.states()) smoothed.push_back(EstimateOf(s));
   return smoothed;
+}
+
+std::vector<FrameEstimate> Estimator::LastEstimates() const {
+  std::vector<FrameEstimate> last = left_window_;
+  for (const auto& [id, s] : window_.states()) last.push_back(EstimateOf(s));
+  return last;
 }
 
 FrameEstimate Estimator::EstimateOf(const State& s) const {

@@ -256,7 +256,10 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
     priors_.push_back(Prior{prior, {kept.begin(), kept.end()}});
     HoldFirstEstimates(kept);
   }
-  for (StateId id : state_ids) RemoveStateBookkeeping(id);
+  for (StateId id : state_ids) {
+    removals_.leaving_states.push_back(states_.at(id));
+    RemoveStateBookkeeping(id);
+  }
   for (LandmarkId id : landmark_ids) landmarks_.erase(id);
   removals_.marginalized_states.insert(removals_.marginalized_states.end(), state_ids.begin(), state_ids.end());
   removals_.marginalized_landmarks.insert(removals_.marginalized_landmarks.end(), landmark_ids.begin(),
@@ -371,6 +374,7 @@ void Window::DropState(StateId id) {
   imu_edges_.erase(outgoing);
   imu_edges_.erase(incoming);
   State& s = state(id);
+  removals_.leaving_states.push_back(s);
   problem_->RemoveParameterBlock(s.pose);
   problem_->RemoveParameterBlock(s.speed_bias);
   states_.erase(id);

@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -207,6 +208,57 @@ TEST(RunSynthetic, FewFeaturesPerFrameAreUsedNotLost) {
   EXPECT_LT(used.evaluation->ate.rmse_m, lost.evaluation->ate.rmse_m);
   ::testing::Test::RecordProperty("ate_used_m", std::to_string(used.evaluation->ate.rmse_m));
   ::testing::Test::RecordProperty("ate_lost_m", std::to_string(lost.evaluation->ate.rmse_m));
+}
+
+// --trajectory=smoothed: every frame's state as last estimated. The first
+// frames (refined by the window after their own frame) differ from the online
+// estimate, the newest frame is the same, and both track the flight.
+TEST(RunSynthetic, SmoothedTrajectoryHoldsEachStateAsItLeftTheWindow) {
+  const std::string online_dir = test::MakeTempDir("run_online");
+  const std::string smoothed_dir = test::MakeTempDir("run_smoothed");
+  const RunResult online = RunOnSynthetic(online_dir);
+  RunRequest request;
+  request.dataset_dir = SyntheticDataset();
+  request.output_dir = smoothed_dir;
+  request.show_progress = false;
+  request.trajectory = "smoothed";
+  const RunResult smoothed = RunDataset(request);
+  ASSERT_EQ(smoothed.status, "ok");
+  ASSERT_TRUE(smoothed.evaluation.has_value() && online.evaluation.has_value());
+  EXPECT_LT(smoothed.evaluation->ate.rmse_m, 0.03);
+  EXPECT_NE(smoothed.evaluation->ate.rmse_m, online.evaluation->ate.rmse_m);
+  const auto rows = [](const std::string& dir) {
+    std::vector<std::string> lines;
+    std::istringstream in(ReadFile(dir + "/trajectory.txt"));
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    return lines;
+  };
+  const std::vector<std::string> a = rows(online_dir), b = rows(smoothed_dir);
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_GT(a.size(), 100u);
+  EXPECT_EQ(a.back(), b.back()) << "the newest state is the same in both";
+  int differing = 0;
+  for (size_t k = 0; k < a.size(); ++k) differing += a[k] != b[k];
+  EXPECT_GT(differing, static_cast<int>(a.size()) / 2);
+  EXPECT_NE(ReadFile(smoothed_dir + "/summary.json").find("\"trajectory\": \"smoothed\""), std::string::npos);
+}
+
+TEST(RunSynthetic, SmoothedTrajectoryWithCovarianceIsAClearError) {
+  RunRequest request;
+  request.dataset_dir = SyntheticDataset();
+  request.output_dir = test::MakeTempDir("run_smoothed_cov");
+  request.show_progress = false;
+  request.trajectory = "smoothed";
+  request.output_covariance = true;
+  EXPECT_THROW(
+      try { RunDataset(request); } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find("--trajectory=smoothed"), std::string::npos) << e.what();
+        throw;
+      },
+      std::exception);
+  request.output_covariance = false;
+  request.trajectory = "lagged";
+  EXPECT_THROW(RunDataset(request), std::exception);
 }
 
 // `vio run` twice as separate processes, exactly as a user would.

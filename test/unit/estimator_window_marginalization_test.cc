@@ -83,6 +83,26 @@ TEST(WindowMarginalization, OldestStateKeepingSharedLandmarksLeavesTheOptimumInP
   ExpectMarginalizingAtTheOptimumKeepsIt(/*keep_landmarks=*/true);
 }
 
+// What leaves is reported as it was last estimated (a fixed-lag smoother's
+// output, Estimator::LastEstimates): the marginalized state's values at the
+// moment it left, not its values when it was added.
+TEST(WindowMarginalization, LeavingStatesAreReportedAsLastEstimated) {
+  static const WindowFixture fixture;
+  Window window(fixture.model, fixture.flight.stereo());
+  fixture.Build(window, /*first=*/70);
+  State& s0 = window.state(StateId(0));
+  s0.SetPose(s0.p_w_b() + Eigen::Vector3d(0.01, -0.02, 0.005), s0.q_w_b());  // as a solve would move it
+  const State solved = s0;
+  window.ClearRemovals();
+  window.Marginalize({StateId(0)}, LandmarksSeenFrom(window, {StateId(0)}));
+  ASSERT_EQ(window.removals().leaving_states.size(), 1u);
+  const State& left = window.removals().leaving_states.front();
+  EXPECT_EQ(left.id, StateId(0));
+  EXPECT_EQ(left.t_ns, solved.t_ns);
+  for (int k = 0; k < 7; ++k) EXPECT_EQ(left.pose[k], solved.pose[k]) << k;
+  for (int k = 0; k < 9; ++k) EXPECT_EQ(left.speed_bias[k], solved.speed_bias[k]) << k;
+}
+
 TEST(WindowMarginalization, DroppingALandmarkRemovesItsObservations) {
   static const WindowFixture fixture;
   Window window(fixture.model, fixture.flight.stereo());

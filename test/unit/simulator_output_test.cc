@@ -97,6 +97,30 @@ TEST(SimulateOutputTest, ImagesSameSeedIsByteIdentical) {
   fs::remove_all(base);
 }
 
+// --noise_seed draws the images' sensor noise too: same trajectory and
+// scene, other pixels; the same noise seed repeats them.
+TEST(SimulateOutputTest, ImagesNoiseSeedChangesTheSensorNoiseOnly) {
+  const std::string base = test::MakeTempDir("vio_sim_image_noise");
+  SimulatorOptions options = Options(base + "/a", 5, SimCameraOutput::kImages, 0.2);
+  options.noise_seed = 7;
+  Simulate(options);
+  options.output_dir = base + "/b";
+  Simulate(options);
+  options.output_dir = base + "/c";
+  options.noise_seed = 8;
+  Simulate(options);
+  const auto a = ReadTree(base + "/a"), b = ReadTree(base + "/b"), c = ReadTree(base + "/c");
+  ExpectSameTrees(a, b);
+  EXPECT_EQ(a.at("mav0/scene.csv"), c.at("mav0/scene.csv"));
+  EXPECT_EQ(a.at("mav0/cam0/data.csv"), c.at("mav0/cam0/data.csv"));
+  int differing_pngs = 0;
+  for (const auto& [path, contents] : a) {
+    if (path.size() > 4 && path.substr(path.size() - 4) == ".png") differing_pngs += contents != c.at(path);
+  }
+  EXPECT_EQ(differing_pngs, 2 * 5);
+  fs::remove_all(base);
+}
+
 TEST(SimulateOutputTest, RejectsBadOptions) {
   EXPECT_THROW(Simulate(Options("", 1, SimCameraOutput::kFeatures, 4.0)), std::invalid_argument);
   const std::string dir = test::MakeTempDir("vio_sim_bad");

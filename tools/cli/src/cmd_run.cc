@@ -13,6 +13,11 @@ DEFINE_bool(output_covariance, false,
 DEFINE_bool(output_observations, false,
             "write observations.csv: every stereo observation given to the estimator (timestamp, landmark id, "
             "rectified u_L, u_R, v), for `vio matchcheck`");
+DEFINE_string(trajectory, "online",
+              "which pose of each frame trajectory.txt and the evaluation hold: online (as estimated at that frame, "
+              "what a real-time user gets) or smoothed (as last estimated: when its state left the window, or at "
+              "the end: a fixed-lag smoother's output, the lag being the window); batch writes its final solve "
+              "either way {online|smoothed}");
 DEFINE_string(config, "", "run configuration YAML (e.g. config/euroc_stereo.yaml); flags override it");
 
 namespace vio::tools {
@@ -33,6 +38,7 @@ int RunMain(const std::vector<std::string>& args) {
   request.config = LoadRunConfig(FLAGS_config);
   request.output_covariance = FLAGS_output_covariance;
   request.output_observations = FLAGS_output_observations;
+  request.trajectory = FLAGS_trajectory;
   const RunResult result = RunDataset(request);
   std::cout << "status " << result.status << ": " << result.frames_estimated << "/" << result.frames
             << " frames, " << result.ms_per_frame << " ms per frame, " << result.real_time_factor

@@ -21,8 +21,9 @@ DEFINE_double(from_duration_s, 0.0, "hybrid mode: only the camera frames of the 
 DEFINE_string(camera, "features", "camera output: features (features0/data.csv) or images (cam0/cam1 PNGs)");
 DEFINE_uint64(seed, 1, "seed of every random draw; same seed, byte-identical output");
 DEFINE_uint64(noise_seed, 0,
-              "seed of the measurement noise alone (IMU noise and biases, features and their pixel noise) when not "
-              "0: same --seed, same trajectory and scene (Monte Carlo runs); 0 = every draw from --seed");
+              "seed of the measurement noise alone (IMU noise and biases, features and their pixel noise, rendered "
+              "images' sensor noise) when not 0: same --seed, same trajectory, scene and textures (Monte Carlo "
+              "runs); 0 = every draw from --seed");
 DEFINE_double(duration_s, 60.0, "synthetic flight length including the 3 s static start [s]");
 DEFINE_double(pixel_noise, 0.5, "feature pixel noise, standard deviation per coordinate [px]");
 DEFINE_double(outlier_rate, 0.0, "probability that a feature observation is a random pixel [0, 1]");

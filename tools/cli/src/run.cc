@@ -212,10 +212,13 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
   progress.Finish();
 }
 
-// The offline policy's final estimates replace the per-frame ones.
-void FinishEstimates(Estimator& estimator, RunOutput& output, RunResult* result) {
+// The offline policy's final estimates replace the per-frame ones, and with
+// --trajectory=smoothed every state's last estimate does.
+void FinishEstimates(Estimator& estimator, const RunRequest& request, RunOutput& output, RunResult* result) {
   try {
-    output.ReplaceEstimates(estimator.Finish());
+    const std::vector<FrameEstimate> final_solve = estimator.Finish();
+    if (request.trajectory == "smoothed") output.ReplaceEstimates(estimator.LastEstimates());
+    output.ReplaceEstimates(final_solve);
   } catch (const std::exception& e) {
     const std::string message = std::string("final solve: ") + e.what() + " (the per-frame estimates are kept)";
     LOG(ERROR) << message;
@@ -297,8 +300,20 @@ void WarnAboutQuestionableSettings(const RunConfig& config) {
 
 }  // namespace
 
+// The request's own settings (the configuration's are ValidateRunConfig's).
+void ValidateRequest(const RunRequest& request) {
+  if (request.trajectory != "online" && request.trajectory != "smoothed") {
+    throw ConfigError("--trajectory='" + request.trajectory + "': expected online or smoothed");
+  }
+  if (request.trajectory == "smoothed" && request.output_covariance) {
+    throw ConfigError("--trajectory=smoothed with --output_covariance: the covariances are of each frame's online "
+                      "estimate (the newest state), not of the smoothed one; use one or the other");
+  }
+}
+
 RunResult RunDataset(const RunRequest& requested) {
   ValidateRunConfig(requested.config);
+  ValidateRequest(requested);
   WarnAboutQuestionableSettings(requested.config);
   const EurocDataset dataset = ReadRunDataset(requested);
   RunRequest request = requested;
@@ -322,7 +337,7 @@ RunResult RunDataset(const RunRequest& requested) {
   EstimateFrames(request, dataset, *source, estimator, output, observations ? &*observations : nullptr, &result);
   if (observations) observations->Close();
   result.tracking = estimator.tracking();
-  if (result.status == "ok") FinishEstimates(estimator, output, &result);
+  if (result.status == "ok") FinishEstimates(estimator, request, output, &result);
   ReportFramesOutsideImu(dataset, *source, request.config.estimator.model.max_imu_gap_s, &result);
   result.processing_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   FinishStatus(estimator, &result);

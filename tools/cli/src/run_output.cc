@@ -109,7 +109,9 @@ void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_jso
   std::ofstream out = OpenForWriting(dir_ + "/summary.json");
   const PolicyOptions& policy = request.config.estimator.policy;
   out << "{\n  \"dataset\": " << JsonString(request.dataset_dir) << ",\n  \"policy\": " << JsonString(policy.policy)
-      << ",\n  \"window_size\": " << policy.window_size << ",\n  \"status\": " << JsonString(r.status)
+      << ",\n  \"window_size\": " << policy.window_size
+      << ",\n  \"trajectory\": " << JsonString(policy.policy == "batch" ? "final" : request.trajectory)
+      << ",\n  \"status\": " << JsonString(r.status)
       << ",\n  \"problems\": " << ProblemsJson(r.problems) << ",\n  \"health\": " << HealthJson(r.health)
       << ",\n  \"frames\": " << r.frames << ",\n  \"frames_estimated\": " << r.frames_estimated
       << ",\n  \"dataset_duration_s\": " << JsonNumber(r.dataset_duration_s)

@@ -175,6 +175,8 @@ void WriteImages(const Simulation& sim, const SimulatorOptions& options, const R
   render.texture_seed = options.seed;
   const ImageTextures textures = LoadImageTextures(options.textures);
   const std::int64_t total = 2 * static_cast<std::int64_t>(sim.frames.size());
+  // The sensor noise is measurement noise: --noise_seed draws it when given.
+  const std::uint64_t image_noise_seed = options.noise_seed != 0 ? options.noise_seed : options.seed;
   cv::Mat radiance, image;
   for (int k = 0; k < 2; ++k) {
     const CameraCalibration& camera = sim.dataset.cameras[k];
@@ -191,7 +193,7 @@ void WriteImages(const Simulation& sim, const SimulatorOptions& options, const R
       for (const Eigen::Isometry3d& T_w_c : poses) {
         renderer.AddRadiance(T_w_c, 1.0f / static_cast<float>(poses.size()), &radiance);
       }
-      ExposeImage(radiance, brightness, vignette, options.sensor, options.seed * 1'000'003ULL + 2 * i + k, &image);
+      ExposeImage(radiance, brightness, vignette, options.sensor, image_noise_seed * 1'000'003ULL + 2 * i + k, &image);
       if (BlackoutAt(sim.frames[i].t_ns, sim.frames.front().t_ns, options.gaps.blackouts) >= 0) {
         image.setTo(cv::Scalar::all(kBlackoutGrey));
       }

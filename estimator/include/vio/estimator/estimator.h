@@ -54,6 +54,11 @@ class Estimator {
   /// it then returns the final estimate of every state (which replaces the
   /// per-frame estimates). Online policies return nothing.
   std::vector<FrameEstimate> Finish();
+  /// Every estimated frame's state as last estimated: a state that left the
+  /// window as it was when it left, one still in it as it is now. For a
+  /// windowed policy, the output of a fixed-lag smoother (the lag is the
+  /// window); ProcessFrame's per-frame estimates are the filter's.
+  std::vector<FrameEstimate> LastEstimates() const;
 
   /// The body pose at t_ns predicted by the IMU from the newest state (for a
   /// front end's outlier rejection); nothing before initialization or when
@@ -99,6 +104,7 @@ class Estimator {
   std::int64_t next_state_id_ = 0;
   std::string waiting_reason_;
   int rejected_observations_ = 0;
+  std::vector<FrameEstimate> left_window_;  ///< states that left the window, as they left
   bool waiting_while_moving_ = false;  ///< the IMU moved at the last frame before initialization
 };
 

@@ -71,6 +71,7 @@ struct Removals {
   std::vector<LandmarkId> marginalized_landmarks;
   std::vector<StateId> dropped_states;
   std::vector<LandmarkId> dropped_landmarks;  ///< incl. those a dropped state left unobserved
+  std::vector<State> leaving_states;  ///< the marginalized and dropped states, as last estimated
 };
 
 /// What went wrong in the window and was survived, counted over its life.

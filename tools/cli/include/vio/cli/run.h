@@ -30,6 +30,10 @@ struct RunRequest {
   bool show_progress = true; ///< progress bar (only drawn on a terminal)
   bool output_covariance = false;  ///< write covariance.csv (one more linearization per frame)
   bool output_observations = false;  ///< write observations.csv (inside the timed loop: a little slower)
+  /// trajectory.txt and the evaluation: "online" (each frame's pose as estimated at that frame) or
+  /// "smoothed" (as last estimated: when its state left the window, or at the end; Estimator::LastEstimates).
+  /// batch writes its final solve either way.
+  std::string trajectory = "online";
 };
 
 /// What a run could not do or had to reject (summary.json "health").

@@ -48,7 +48,7 @@ struct SimulatorOptions {
   /// Seed of every random draw (std::mt19937_64).
   std::uint64_t seed = 1;
   /// Seed of the measurement noise alone (IMU noise and biases, feature
-  /// selection and pixel noise) when not 0: the trajectory and the scene
+  /// selection and pixel noise, rendered images' sensor noise) when not 0: the trajectory and the scene
   /// (from `seed`) stay the same, so runs with different noise seeds are
   /// Monte Carlo realizations of one experiment. 0 = every draw from `seed`.
   std::uint64_t noise_seed = 0;
