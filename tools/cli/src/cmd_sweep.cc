@@ -129,6 +129,12 @@ SweepRequest SweepRequestFromFlags(const std::vector<std::string>& args) {
         throw std::invalid_argument("--simulate_flags: '" + flag + "' is set by the sweep for every seed");
       }
     }
+    for (const std::string& flag : request.run_flags) {
+      if (flag.rfind("--trajectory=smoothed", 0) == 0) {
+        throw std::invalid_argument("--seeds computes the NEES of the online estimates: '" + flag +
+                                    "' cannot be evaluated with their covariances");
+      }
+    }
     request.run_flags.push_back("--output_covariance=true");
     request.datasets = SimulateSeedDatasets(request, std::cout);
   } else if (!request.simulate_flags.empty()) {
