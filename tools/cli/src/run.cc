@@ -212,13 +212,10 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
   progress.Finish();
 }
 
-// The offline policy's final estimates replace the per-frame ones, and with
-// --trajectory=smoothed every state's last estimate does.
-void FinishEstimates(Estimator& estimator, const RunRequest& request, RunOutput& output, RunResult* result) {
+// The offline policy's final estimates replace the per-frame ones.
+void FinishEstimates(Estimator& estimator, RunOutput& output, RunResult* result) {
   try {
-    const std::vector<FrameEstimate> final_solve = estimator.Finish();
-    if (request.trajectory == "smoothed") output.ReplaceEstimates(estimator.LastEstimates());
-    output.ReplaceEstimates(final_solve);
+    output.ReplaceEstimates(estimator.Finish());
   } catch (const std::exception& e) {
     const std::string message = std::string("final solve: ") + e.what() + " (the per-frame estimates are kept)";
     LOG(ERROR) << message;
@@ -298,8 +295,6 @@ void WarnAboutQuestionableSettings(const RunConfig& config) {
   }
 }
 
-}  // namespace
-
 // The request's own settings (the configuration's are ValidateRunConfig's).
 void ValidateRequest(const RunRequest& request) {
   if (request.trajectory != "online" && request.trajectory != "smoothed") {
@@ -310,6 +305,8 @@ void ValidateRequest(const RunRequest& request) {
                       "estimate (the newest state), not of the smoothed one; use one or the other");
   }
 }
+
+}  // namespace
 
 RunResult RunDataset(const RunRequest& requested) {
   ValidateRunConfig(requested.config);
@@ -337,7 +334,9 @@ RunResult RunDataset(const RunRequest& requested) {
   EstimateFrames(request, dataset, *source, estimator, output, observations ? &*observations : nullptr, &result);
   if (observations) observations->Close();
   result.tracking = estimator.tracking();
-  if (result.status == "ok") FinishEstimates(estimator, request, output, &result);
+  // Every frame's state as last estimated, whether the run finished or stopped.
+  if (request.trajectory == "smoothed") output.ReplaceEstimates(estimator.LastEstimates());
+  if (result.status == "ok") FinishEstimates(estimator, output, &result);
   ReportFramesOutsideImu(dataset, *source, request.config.estimator.model.max_imu_gap_s, &result);
   result.processing_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   FinishStatus(estimator, &result);
