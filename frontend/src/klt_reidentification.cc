@@ -8,11 +8,14 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "parabola_vertex.h"
+#include "correlation_peak.h"
 
 namespace vio::frontend {
 namespace {
 
+using detail::kMinPatchStdGrey;
+using detail::kPeakHalfWidthPx;
+using detail::kUniquenessMargin;
 using detail::ParabolaVertex;
 
 /// Side of the left-image patch remembered per landmark and sought by ZNCC
@@ -31,14 +34,6 @@ constexpr int kReidentifyPatchPx = 21;
 /// re-identification) 0.8 added 13 wrong re-acquisitions and 392 wrong
 /// continuing observations, 0.9 added 2 and removed 246 [ZNCC].
 constexpr double kReidentifyMinNcc = 0.9;
-/// Patches with a smaller standard deviation are flat and not remembered
-/// [grey levels].
-constexpr double kMinPatchStdGrey = 2.0;
-/// Re-identification's uniqueness test: a position further than
-/// kPeakHalfWidthPx (in x or y) from the best that scores within
-/// kUniquenessMargin of it makes the best ambiguous [px], [ZNCC].
-constexpr int kPeakHalfWidthPx = 2;
-constexpr double kUniquenessMargin = 0.05;
 
 // Whether a score other than those within kPeakHalfWidthPx of `best` comes
 // within kUniquenessMargin of it.

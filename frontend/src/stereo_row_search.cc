@@ -8,20 +8,16 @@
 #include <glog/logging.h>
 #include <opencv2/imgproc.hpp>
 
-#include "parabola_vertex.h"
+#include "correlation_peak.h"
 
 namespace vio::frontend {
 namespace {
 
+using detail::kMinPatchStdGrey;
+using detail::kPeakHalfWidthPx;
+using detail::kUniquenessMargin;
 using detail::ParabolaVertex;
 
-/// A second peak (beyond kPeakHalfWidthPx of the best) scoring within this
-/// much of the best makes the match ambiguous [ZNCC].
-constexpr double kUniquenessMargin = 0.05;
-/// Half width of the best peak excluded from the uniqueness test [px].
-constexpr int kPeakHalfWidthPx = 2;
-/// Templates with a smaller standard deviation are flat [grey levels].
-constexpr double kMinPatchStdGrey = 2.0;
 /// Samples per image side when bounding the rectified images [count].
 constexpr int kBorderSamples = 64;
 
