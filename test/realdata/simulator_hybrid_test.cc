@@ -41,5 +41,35 @@ TEST(SimulateHybridTest, V2_01FeaturesAlongTheRealTrajectory) {
   RecordProperty("median_track_length", std::to_string(MedianTrackLength(sim.features)));
 }
 
+// MH_04's ground truth jumps 13 cm in one 5 ms step at 45 s. The hybrid
+// simulation removes it by default: its ground truth and cameras then move as
+// the velocity (and the real IMU) says, and the part before is the real one;
+// with keep_groundtruth_jumps the jump stays.
+TEST(SimulateHybridTest, MH_04GroundTruthJumpIsRemovedUnlessKept) {
+  const std::string sequence = test::EurocSequence("MH_04_difficult");
+  VIO_REQUIRE_DATA(sequence);
+  SimulatorOptions options;
+  options.from_euroc_dir = sequence;
+  options.from_duration_s = 50.0;
+  const Simulation sim = BuildSimulation(options);
+  ASSERT_EQ(sim.groundtruth_jumps.size(), 1u);
+  const GroundTruthJump& jump = sim.groundtruth_jumps[0];
+  EXPECT_NEAR(jump.step_m, 0.13, 0.01);
+  EXPECT_TRUE(FindGroundTruthJumps(sim.dataset.groundtruth, 5.0).empty());
+
+  options.keep_groundtruth_jumps = true;
+  const Simulation kept = BuildSimulation(options);
+  ASSERT_EQ(FindGroundTruthJumps(kept.dataset.groundtruth, 5.0).size(), 1u);
+  ASSERT_EQ(kept.frames.size(), sim.frames.size());
+  for (size_t i = 0; i < sim.frames.size(); ++i) {
+    const double moved = (kept.frames[i].T_w_b.translation() - sim.frames[i].T_w_b.translation()).norm();
+    if (sim.frames[i].t_ns <= jump.t_ns) {
+      EXPECT_EQ(moved, 0.0) << i;
+    } else if (sim.frames[i].t_ns >= jump.end_ns) {
+      EXPECT_NEAR(moved, jump.excess_m.norm(), 1e-9) << i;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace vio::tools

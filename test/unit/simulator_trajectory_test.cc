@@ -106,9 +106,48 @@ TEST(GroundTruthJumpsTest, FindsAStepThatDisagreesWithTheVelocity) {
   EXPECT_NEAR(jumps[0].step_m, 0.105, 1e-12);
   EXPECT_NEAR(jumps[0].speed_m_s, 21.0, 1e-9);
   EXPECT_NEAR(jumps[0].velocity_m_s, 1.0, 1e-12);
+  EXPECT_EQ(jumps[0].end_ns, 200 * 5'000'000);
+  EXPECT_LT((jumps[0].excess_m - Eigen::Vector3d(0.1, 0, 0)).norm(), 1e-12);
   // Without velocities (TUM text) nothing can be judged.
   for (GroundTruthState& s : gt) s.has_velocity_and_biases = false;
   EXPECT_TRUE(FindGroundTruthJumps(gt, 5.0).empty());
+}
+
+// Two glitches, one of them back: removing them leaves a ground truth whose
+// every step agrees with its velocity, the samples before the first
+// untouched, and orientation and velocity as they were.
+TEST(GroundTruthJumpsTest, RemovingThemLeavesAGroundTruthTheVelocityExplains) {
+  std::vector<GroundTruthState> gt(600);
+  for (size_t i = 0; i < gt.size(); ++i) {
+    const double t = 0.005 * static_cast<double>(i);
+    gt[i].t_ns = static_cast<Timestamp>(i) * 5'000'000;
+    gt[i].p_w_b = Eigen::Vector3d(t, std::sin(t), 0.5 * t * t);
+    gt[i].v_w_b = Eigen::Vector3d(1, std::cos(t), t);
+    gt[i].q_w_b = Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * t, Eigen::Vector3d::UnitZ()));
+    if (i >= 200) gt[i].p_w_b += Eigen::Vector3d(0.1, -0.05, 0.02);
+    if (i >= 400) gt[i].p_w_b -= Eigen::Vector3d(0.0, 0.2, 0.0);
+  }
+  const std::vector<GroundTruthJump> jumps = FindGroundTruthJumps(gt, 5.0);
+  ASSERT_EQ(jumps.size(), 2u);
+  const std::vector<GroundTruthState> repaired = RemoveGroundTruthJumps(gt, jumps);
+  ASSERT_EQ(repaired.size(), gt.size());
+  EXPECT_TRUE(FindGroundTruthJumps(repaired, 5.0).empty());
+  // Between samples the velocity explains the steps to the trapezoid rule's
+  // error; through each former jump as well.
+  for (size_t i : {199u, 399u}) {
+    const Eigen::Vector3d step = repaired[i + 1].p_w_b - repaired[i].p_w_b;
+    EXPECT_LT((step - 0.005 * 0.5 * (repaired[i].v_w_b + repaired[i + 1].v_w_b)).norm(), 1e-5) << i;
+  }
+  for (size_t i = 0; i < gt.size(); ++i) {
+    if (i < 200) {
+      EXPECT_EQ(repaired[i].p_w_b, gt[i].p_w_b) << i;
+    }
+    EXPECT_EQ(repaired[i].v_w_b, gt[i].v_w_b);
+    EXPECT_EQ(repaired[i].q_w_b.coeffs(), gt[i].q_w_b.coeffs());
+  }
+  // Removing nothing changes nothing.
+  const std::vector<GroundTruthState> same = RemoveGroundTruthJumps(gt, {});
+  for (size_t i = 0; i < gt.size(); ++i) EXPECT_EQ(same[i].p_w_b, gt[i].p_w_b);
 }
 
 }  // namespace

@@ -102,6 +102,23 @@ void BuildSyntheticMotion(const SimulatorOptions& options, std::mt19937_64* rng,
   }
 }
 
+// One warning per jump of the source ground truth, saying what became of it.
+void WarnOfGroundTruthJumps(const SimulatorOptions& options, const std::vector<GroundTruthJump>& jumps) {
+  for (const GroundTruthJump& jump : jumps) {
+    std::ostringstream what;
+    what << std::fixed << std::setprecision(3) << options.from_euroc_dir << ": the ground truth jumps " << jump.step_m
+         << " m at t=" << NanosToSeconds(jump.t_ns) << " s (" << jump.speed_m_s << " m/s against its velocity of "
+         << jump.velocity_m_s << " m/s); ";
+    if (options.keep_groundtruth_jumps) {
+      what << "kept: the simulated cameras follow the jump, the real IMU does not";
+    } else {
+      what << "removed: from then on the ground truth (the cameras' and the written one) is moved back by the "
+           << jump.excess_m.norm() << " m its velocity does not explain";
+    }
+    LOG(WARNING) << what.str();
+  }
+}
+
 void BuildHybridMotion(const SimulatorOptions& options, Simulation* sim) {
   EurocReadOptions read;
   read.read_features = false;
@@ -111,10 +128,10 @@ void BuildHybridMotion(const SimulatorOptions& options, Simulation* sim) {
   if (dataset.groundtruth.empty() || dataset.frames[0].empty()) {
     throw DatasetError(options.from_euroc_dir + ": hybrid mode needs ground truth and cam0/data.csv");
   }
-  for (const GroundTruthJump& jump : FindGroundTruthJumps(dataset.groundtruth, kMaxGroundTruthVelocityMismatch)) {
-    LOG(WARNING) << std::fixed << std::setprecision(3) << options.from_euroc_dir << ": the ground truth jumps "
-                 << jump.step_m << " m at t=" << NanosToSeconds(jump.t_ns) << " s (" << jump.speed_m_s << " m/s against its velocity of "
-                 << jump.velocity_m_s << " m/s); the simulated cameras follow the jump, the real IMU does not";
+  sim->groundtruth_jumps = FindGroundTruthJumps(dataset.groundtruth, kMaxGroundTruthVelocityMismatch);
+  WarnOfGroundTruthJumps(options, sim->groundtruth_jumps);
+  if (!options.keep_groundtruth_jumps) {
+    dataset.groundtruth = RemoveGroundTruthJumps(std::move(dataset.groundtruth), sim->groundtruth_jumps);
   }
   dataset.root.clear();
   dataset.features.clear();
@@ -152,6 +169,8 @@ SimulationSummary Summarize(const Simulation& sim, const SimulatorOptions& optio
     summary.stereo_features_per_frame = std::accumulate(stereo.begin(), stereo.end(), 0.0) / stereo.size();
   }
   summary.median_track_length = MedianTrackLength(sim.features);
+  summary.groundtruth_jumps = static_cast<int>(sim.groundtruth_jumps.size());
+  summary.groundtruth_jumps_kept = options.keep_groundtruth_jumps;
   return summary;
 }
 
@@ -276,6 +295,10 @@ std::string FormatSummary(const SimulationSummary& summary, const std::string& o
        << " seen in both cameras), median track length " << summary.median_track_length << " frames; ";
   } else {
     os << 2 * summary.frames << " images rendered; ";
+  }
+  if (summary.groundtruth_jumps > 0) {
+    os << summary.groundtruth_jumps << " ground-truth jump" << (summary.groundtruth_jumps > 1 ? "s " : " ")
+       << (summary.groundtruth_jumps_kept ? "kept" : "removed") << "; ";
   }
   os << "took " << summary.seconds << " s; wrote " << output_dir << "\n";
   return os.str();

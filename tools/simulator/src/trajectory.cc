@@ -191,9 +191,20 @@ std::vector<GroundTruthJump> FindGroundTruthJumps(const std::vector<GroundTruthS
     const Eigen::Vector3d step = b.p_w_b - a.p_w_b;
     const Eigen::Vector3d mean_velocity = 0.5 * (a.v_w_b + b.v_w_b);
     if ((step / dt_s - mean_velocity).norm() <= tolerance_m_s) continue;
-    jumps.push_back({a.t_ns, step.norm(), step.norm() / dt_s, mean_velocity.norm()});
+    jumps.push_back({a.t_ns, b.t_ns, step.norm(), step.norm() / dt_s, mean_velocity.norm(), step - dt_s * mean_velocity});
   }
   return jumps;
+}
+
+std::vector<GroundTruthState> RemoveGroundTruthJumps(std::vector<GroundTruthState> groundtruth,
+                                                     const std::vector<GroundTruthJump>& jumps) {
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  auto jump = jumps.begin();
+  for (GroundTruthState& s : groundtruth) {
+    for (; jump != jumps.end() && jump->end_ns <= s.t_ns; ++jump) shift -= jump->excess_m;
+    s.p_w_b += shift;
+  }
+  return groundtruth;
 }
 
 }  // namespace vio::tools

@@ -43,6 +43,12 @@ struct SimulatorOptions {
   std::string from_euroc_dir;
   /// Hybrid mode: camera frames of the first this many seconds only (0: all) [s].
   double from_duration_s = 0.0;
+  /// Hybrid mode: ground-truth steps that disagree with the ground truth's own
+  /// velocity by more than 5 m/s (a glitch of the reference: EuRoC MH_04 has
+  /// one of 13 cm in 5 ms) are removed (RemoveGroundTruthJumps: the cameras and
+  /// the written ground truth move as the real IMU does) unless this is set
+  /// (the cameras then jump with the ground truth, the real IMU does not).
+  bool keep_groundtruth_jumps = false;
   /// What the cameras produce.
   SimCameraOutput camera_output = SimCameraOutput::kFeatures;
   /// Seed of every random draw (std::mt19937_64).
@@ -86,6 +92,7 @@ struct Simulation {
   Scene scene;                     ///< the world; landmark index = feature_id
   std::vector<FramePose> frames;   ///< body pose at each camera frame
   FeatureSimulation features;      ///< per-frame counts and track lengths (features mode)
+  std::vector<GroundTruthJump> groundtruth_jumps;  ///< hybrid: the source ground truth's jumps (removed unless kept)
 };
 
 struct SimulationSummary {
@@ -97,6 +104,8 @@ struct SimulationSummary {
   double features_per_frame = 0.0;         ///< cam0 observations per frame
   double stereo_features_per_frame = 0.0;  ///< landmarks seen in both cameras per frame
   double median_track_length = 0.0;        ///< [frames]
+  int groundtruth_jumps = 0;               ///< hybrid: jumps found in the source ground truth
+  bool groundtruth_jumps_kept = false;     ///< ... and left in (keep_groundtruth_jumps)
   double seconds = 0.0;                    ///< wall time [s]
 };
 

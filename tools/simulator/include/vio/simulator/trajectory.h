@@ -90,15 +90,27 @@ std::optional<Eigen::Isometry3d> InterpolatePose(const std::vector<GroundTruthSt
 /// 14 cm in 5 ms). A hybrid simulation follows it with its cameras while the
 /// real IMU does not.
 struct GroundTruthJump {
-  Timestamp t_ns = 0;        ///< start of the step
+  Timestamp t_ns = 0;        ///< start of the step (t_a)
+  Timestamp end_ns = 0;      ///< end of the step (t_b): the first sample after the jump
   double step_m = 0.0;       ///< |p(t_b) - p(t_a)| [m]
   double speed_m_s = 0.0;    ///< step_m / (t_b - t_a) [m/s]
   double velocity_m_s = 0.0; ///< |v(t_a) + v(t_b)| / 2 from the ground truth [m/s]
+  /// What the step moved beyond the ground truth's own velocity:
+  /// (p_b - p_a) - (v_a + v_b) / 2 (t_b - t_a), world frame [m].
+  Eigen::Vector3d excess_m = Eigen::Vector3d::Zero();
 };
 
 /// The steps where |(p_b - p_a) / (t_b - t_a) - (v_a + v_b) / 2| exceeds
 /// tolerance_m_s; none for a ground truth without velocities (TUM).
 std::vector<GroundTruthJump> FindGroundTruthJumps(const std::vector<GroundTruthState>& groundtruth,
                                                   double tolerance_m_s);
+
+/// The ground truth without its jumps: every sample from a jump's end on is
+/// moved by -excess_m, so each step agrees with the ground truth's velocity
+/// again. Orientations, velocities and biases are kept; so is a jump's
+/// share the velocity explains. `jumps` from FindGroundTruthJumps on the
+/// same ground truth.
+std::vector<GroundTruthState> RemoveGroundTruthJumps(std::vector<GroundTruthState> groundtruth,
+                                                     const std::vector<GroundTruthJump>& jumps);
 
 }  // namespace vio::tools
