@@ -85,6 +85,9 @@ TEST(BuildSceneTest, RejectsBadOptions) {
   options = SceneOptions();
   options.room_size_m.z() = -1.0;
   EXPECT_THROW(BuildScene(options, {}, &rng), std::invalid_argument);
+  options = SceneOptions();
+  options.trajectory_margin_m = -0.1;
+  EXPECT_THROW(BuildScene(options, {}, &rng), std::invalid_argument);
 }
 
 Scene OneBoxScene() {

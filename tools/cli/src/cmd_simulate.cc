@@ -33,6 +33,8 @@ DEFINE_double(pixel_noise, 0.5, "feature pixel noise, standard deviation per coo
 DEFINE_double(outlier_rate, 0.0, "probability that a feature observation is a random pixel [0, 1]");
 DEFINE_int32(max_features, 150, "feature budget per frame (cam0 tracks)");
 DEFINE_string(room_size, "8,8,4", "room extent x,y,z [m] (grown to enclose a hybrid trajectory)");
+DEFINE_double(room_margin, 0.3, "the room grows until the trajectory keeps this distance to every wall, the floor "
+              "and the ceiling (hybrid trajectories that leave the --room_size room) [m]");
 DEFINE_double(landmark_density, 10.0, "landmarks per square metre of wall, floor, ceiling and box");
 DEFINE_int32(num_boxes, 8, "clutter boxes on the floor");
 DEFINE_double(min_range, 0.25, "nearest observable landmark [m]");
@@ -117,6 +119,7 @@ SimulatorOptions OptionsFromFlags() {
   options.features.min_range_m = FLAGS_min_range;
   options.features.max_range_m = FLAGS_max_range;
   options.scene.room_size_m = ParseVector3("room_size", FLAGS_room_size);
+  options.scene.trajectory_margin_m = FLAGS_room_margin;
   options.scene.landmark_density_per_m2 = FLAGS_landmark_density;
   options.scene.num_boxes = FLAGS_num_boxes;
   options.trajectory.max_speed_m_s = FLAGS_max_speed;

@@ -50,6 +50,10 @@ void CheckOptions(const SceneOptions& options) {
   if (!(options.room_size_m.minCoeff() > 0.0)) {
     throw std::invalid_argument("scene: room size must be positive in x, y and z");
   }
+  if (!(options.trajectory_margin_m >= 0.0)) {
+    throw std::invalid_argument("scene: the room margin around the trajectory must be >= 0, got " +
+                                std::to_string(options.trajectory_margin_m) + " m");
+  }
   if (!(options.landmark_density_per_m2 > 0.0)) {
     throw std::invalid_argument("scene: landmark density must be positive, got " +
                                 std::to_string(options.landmark_density_per_m2));
