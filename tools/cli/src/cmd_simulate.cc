@@ -19,7 +19,7 @@ DEFINE_string(from, "", "hybrid mode: real EuRoC ASL folder whose IMU, ground tr
 DEFINE_double(from_duration_s, 0.0, "hybrid mode: only the camera frames of the first S seconds of the sequence "
               "(0: all) [s]");
 DEFINE_string(groundtruth_jumps, "remove", "hybrid mode: ground-truth steps that disagree with its own velocity by "
-              "more than 5 m/s (EuRoC MH_04 has one of 13 cm in 5 ms at 45 s): remove (the ground truth from then on "
+              "more than 5 m/s (EuRoC MH_04 has one of 14 cm in 5 ms at 45 s): remove (the ground truth from then on "
               "is moved back by what its velocity does not explain, so the cameras move as the real IMU does; the "
               "written ground truth too) or keep (the cameras jump, the real IMU does not) {remove|keep}");
 DEFINE_string(camera, "features", "camera output: features (features0/data.csv) or images (cam0/cam1 PNGs)");

@@ -5,10 +5,12 @@
 //    room with clutter (scene.h), IMU synthesized from the analytic
 //    trajectory with EuRoC noise (imu.h), the real EuRoC V2_01
 //    calibration, camera frames at the camera rate.
-//  * hybrid (from_euroc_dir set): the real IMU, ground truth and
-//    calibration of an ASL folder copied unchanged; the cameras see the
-//    synthetic room along the real ground truth (interpolated at the real
-//    cam0 stamps; frames outside the ground truth are dropped).
+//  * hybrid (from_euroc_dir set): the real IMU and calibration of an ASL
+//    folder copied unchanged, its ground truth too but for glitches that
+//    disagree with its own velocity (removed unless keep_groundtruth_jumps);
+//    the cameras see the synthetic room along that ground truth
+//    (interpolated at the real cam0 stamps; frames outside the ground truth
+//    are dropped).
 // The camera side is either feature tracks (features0/data.csv,
 // features.h) or rendered stereo PNG images (cam0/cam1, render.h): surfaces
 // textured with real images (texture.h), then exposed by a simulated sensor
@@ -45,7 +47,7 @@ struct SimulatorOptions {
   double from_duration_s = 0.0;
   /// Hybrid mode: ground-truth steps that disagree with the ground truth's own
   /// velocity by more than 5 m/s (a glitch of the reference: EuRoC MH_04 has
-  /// one of 13 cm in 5 ms) are removed (RemoveGroundTruthJumps: the cameras and
+  /// one of 14 cm in 5 ms) are removed (RemoveGroundTruthJumps: the cameras and
   /// the written ground truth move as the real IMU does) unless this is set
   /// (the cameras then jump with the ground truth, the real IMU does not).
   bool keep_groundtruth_jumps = false;

@@ -87,8 +87,8 @@ std::optional<Eigen::Isometry3d> InterpolatePose(const std::vector<GroundTruthSt
 
 /// A ground-truth step whose displacement disagrees with the ground truth's
 /// own velocity: a glitch of the reference (EuRoC MH_04_difficult has one of
-/// 14 cm in 5 ms). A hybrid simulation follows it with its cameras while the
-/// real IMU does not.
+/// 14 cm in 5 ms). A hybrid simulation that kept it would move its cameras
+/// with it while the real IMU does not; RemoveGroundTruthJumps takes it out.
 struct GroundTruthJump {
   Timestamp t_ns = 0;        ///< start of the step (t_a)
   Timestamp end_ns = 0;      ///< end of the step (t_b): the first sample after the jump
