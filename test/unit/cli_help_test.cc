@@ -86,5 +86,17 @@ TEST(CliHelp, AStrayArgumentIsNamedNotMistakenForAMissingFlag) {
   EXPECT_THAT(missing.text, HasSubstr("--output_dir is required"));
 }
 
+TEST(CliHelp, SimulateNamesABadJumpModeOrRoomMarginAndWritesNothing) {
+  const std::string dir = test::MakeTempDir("cli_help") + "/sim";
+  const Output jumps = Vio("simulate --output_dir=" + dir + " --groundtruth_jumps=smooth");
+  EXPECT_EQ(jumps.exit_code, 2);
+  EXPECT_THAT(jumps.text, HasSubstr("--groundtruth_jumps=smooth: expected 'remove' or 'keep'"));
+  const Output margin = Vio("simulate --output_dir=" + dir + " --room_margin=-1");
+  EXPECT_EQ(margin.exit_code, 2);
+  EXPECT_THAT(margin.text, HasSubstr("room margin around the trajectory must be >= 0"));
+  std::ifstream imu(dir + "/mav0/imu0/data.csv");
+  EXPECT_FALSE(imu.good());
+}
+
 }  // namespace
 }  // namespace vio::tools
