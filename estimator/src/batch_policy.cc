@@ -52,7 +52,9 @@ bool BatchPolicy::Finish(Window& window) {
   // Ceres' own tolerance: the default function_tolerance (1e-3) is set for
   // the Gauss-Newton steps of a window, not for the final solve of everything.
   solver.function_tolerance = 1e-6;
-  solver.max_solver_time_s = 3600;
+  // Bounded by iterations only (a configured wall-time bound is for a window's
+  // solves): the final estimate does not depend on machine load.
+  solver.max_solver_time_s = 0;
   solver.linear_solver = "sparse_full";
   const SolveReport report = window.Solve(solver);
   LOG(INFO) << "batch: final solve over " << window.states().size() << " states and " << window.landmarks().size()

@@ -32,7 +32,6 @@ struct WindowFixture {
 SolverOptions Converge() {
   SolverOptions solver;
   solver.max_iterations = 100;
-  solver.max_solver_time_s = 60;
   solver.function_tolerance = 1e-16;
   return solver;
 }
