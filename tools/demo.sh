@@ -19,12 +19,6 @@ step 1 "installing the Debian packages that are missing (nothing when all are th
 "$root/tools/install_deps.sh"
 
 step 2 "building vio (Release, only what the demo needs)"
-# A fresh build folder is configured for a fast build from scratch (unity
-# sources, see CMakeLists.txt); an existing one keeps its settings, so the
-# demo never rebuilds what tools/test.sh built.
-if [ ! -f "$build/CMakeCache.txt" ]; then
-  export CMAKE_ARGS="-DVIO_UNITY_BUILD=ON ${CMAKE_ARGS:-}"
-fi
 "$root/tools/build.sh" --progress vio
 
 step 3 "simulating a 30 s flight through a room: $out/synthetic_30s"

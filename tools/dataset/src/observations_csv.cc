@@ -9,14 +9,14 @@
 namespace vio::tools {
 namespace {
 
-const std::vector<std::string> kColumns = {"timestamp [ns]", "landmark_id", "u_L [px]", "u_R [px]", "v [px]"};
+const std::vector<std::string> kObservationsCsvColumns = {"timestamp [ns]", "landmark_id", "u_L [px]", "u_R [px]", "v [px]"};
 
 }  // namespace
 
 ObservationsCsvWriter::ObservationsCsvWriter(std::string path) : path_(std::move(path)), out_(path_) {
   if (!out_) throw DatasetError(path_ + ": cannot write");
   TextWriter header(path_);
-  header.Header(kColumns);
+  header.Header(kObservationsCsvColumns);
   out_ << header.text();
 }
 
@@ -37,7 +37,7 @@ void ObservationsCsvWriter::Close() {
 }
 
 std::vector<StereoFrame> ReadObservationsCsv(const std::string& path) {
-  CsvReader reader(path, kColumns);
+  CsvReader reader(path, kObservationsCsvColumns);
   TimestampOrder order(/*allow_equal=*/true);
   std::vector<StereoFrame> frames;
   std::set<std::int64_t> ids_in_frame;

@@ -6,7 +6,7 @@
 namespace vio::tools {
 namespace {
 
-const std::vector<std::string> kColumns = {"kind",      "min_x [m]", "min_y [m]", "min_z [m]",
+const std::vector<std::string> kSceneCsvColumns = {"kind",      "min_x [m]", "min_y [m]", "min_z [m]",
                                            "max_x [m]", "max_y [m]", "max_z [m]"};
 
 void AddRow(const char* kind, const Eigen::AlignedBox3d& box, TextWriter* out) {
@@ -21,14 +21,14 @@ void AddRow(const char* kind, const Eigen::AlignedBox3d& box, TextWriter* out) {
 
 void WriteSceneCsv(const SceneBoxes& scene, const std::string& path) {
   TextWriter out(path);
-  out.Header(kColumns);
+  out.Header(kSceneCsvColumns);
   AddRow("room", scene.room, &out);
   for (const Eigen::AlignedBox3d& box : scene.boxes) AddRow("box", box, &out);
   out.Save();
 }
 
 SceneBoxes ReadSceneCsv(const std::string& path) {
-  CsvReader reader(path, kColumns);
+  CsvReader reader(path, kSceneCsvColumns);
   SceneBoxes scene;
   bool has_room = false;
   while (reader.NextRow()) {
