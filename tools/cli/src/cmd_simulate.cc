@@ -60,8 +60,14 @@ DEFINE_double(shot_noise, 1.5, "rendered images: shot noise at grey 128, standar
               "(variance proportional to the signal)");
 DEFINE_int32(png_compression, 0, "PNG compression level of rendered images, 0..9 (0: stored uncompressed, as "
              "EuRoC's PNGs are, the fastest to decode; 1-9: smaller files, twice the decoding time)");
-DEFINE_double(drop_frames, 0.0, "fraction of the camera frames removed, in gaps of --drop_gap_frames [0, 1)");
-DEFINE_int32(drop_gap_frames, 1, "consecutive frames removed per gap (1 at 20 Hz: 100 ms gaps)");
+DEFINE_double(drop_frames, 0.0, "fraction of the camera frames removed, in gaps placed by --drop_pattern [0, 1)");
+DEFINE_int32(drop_gap_frames, 1,
+             "--drop_pattern=even: consecutive frames removed per gap (1 at 20 Hz: 100 ms gaps); burst: the longest "
+             "burst");
+DEFINE_string(drop_pattern, "even",
+              "where dropped frames go: even (gaps of exactly --drop_gap_frames, evenly spread) or burst (bursts of "
+              "1 to --drop_gap_frames frames, more where the camera rotates fast, as real recordings drop them; e.g. "
+              "--drop_frames=0.2 --drop_gap_frames=3 --drop_pattern=burst) {even|burst}");
 DEFINE_string(blackouts, "", "spans with nothing to track, START:DURATION[,...] in s after the first frame: "
               "no features, black images");
 
@@ -138,6 +144,7 @@ SimulatorOptions OptionsFromFlags() {
   options.png_compression = FLAGS_png_compression;
   options.gaps.drop_fraction = FLAGS_drop_frames;
   options.gaps.gap_frames = FLAGS_drop_gap_frames;
+  options.gaps.pattern = ParseDropPattern("drop_pattern", FLAGS_drop_pattern);
   options.gaps.blackouts = ParseBlackouts("blackouts", FLAGS_blackouts);
   return options;
 }

@@ -18,11 +18,21 @@ struct Blackout {
   double duration_s = 0.0;  ///< [s]
 };
 
+/// Where dropped frames go: kEven (gaps of exactly `gap_frames`, one per
+/// equal block of frames) or kBurst (bursts of 1..`gap_frames` frames, placed
+/// more often where the camera rotates fast, as real recordings drop them).
+enum class DropPattern { kEven, kBurst };
+
+/// "even" or "burst"; throws std::invalid_argument naming `flag` otherwise.
+DropPattern ParseDropPattern(const std::string& flag, const std::string& text);
+
 struct FrameGapOptions {
-  /// Fraction of the frames removed, in gaps of `gap_frames` [0, 1).
+  /// Fraction of the frames removed [0, 1).
   double drop_fraction = 0.0;
-  /// Consecutive frames removed per gap (1 at 20 Hz: a 100 ms gap).
+  /// kEven: consecutive frames removed per gap (1 at 20 Hz: a 100 ms gap);
+  /// kBurst: the longest burst.
   int gap_frames = 1;
+  DropPattern pattern = DropPattern::kEven;
   std::vector<Blackout> blackouts;
 };
 
@@ -31,11 +41,15 @@ struct FrameGapOptions {
 /// overlapping entry.
 std::vector<Blackout> ParseBlackouts(const std::string& flag, const std::string& text);
 
-/// The frames without the dropped ones: round(drop_fraction * n / gap_frames)
-/// gaps, one at a random place in each of as many equal blocks of frames, so
-/// gaps never touch; the first and the last frame are kept. Deterministic for
-/// `rng`, which is not used when nothing is dropped. Throws
-/// std::invalid_argument when the gaps do not fit.
+/// The frames without the dropped ones. kEven: round(drop_fraction * n /
+/// gap_frames) gaps, one at a random place in each of as many equal blocks of
+/// frames. kBurst: round(drop_fraction * n) frames in bursts of a uniform
+/// 1..gap_frames frames, each starting at a frame drawn with weight 0.25 +
+/// (angular rate there) / (mean angular rate), so fast rotation drops more.
+/// Either way gaps never touch and the first and the last frame are kept.
+/// Deterministic for `rng`, which is not used when nothing is dropped. Throws
+/// std::invalid_argument naming --drop_frames / --drop_gap_frames when the
+/// options are out of range or the gaps do not fit.
 std::vector<FramePose> DropFrames(const std::vector<FramePose>& frames, const FrameGapOptions& options,
                                   std::mt19937_64* rng);
 
