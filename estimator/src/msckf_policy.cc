@@ -18,6 +18,11 @@ Eigen::Isometry3d BodyPose(const State& s) {
   return T_w_b;
 }
 
+// The loosest reprojection gate the MSCKF applies [sigma].
+double MostReprojectionError(const EstimatorOptions& options) {
+  return std::max(options.msckf.msckf_max_reprojection, options.model.max_whitened_residual);
+}
+
 bool IsLeaving(StateId state, const std::vector<StateId>& leaving) {
   return std::find(leaving.begin(), leaving.end(), state) != leaving.end();
 }
@@ -55,7 +60,8 @@ PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
   timing.solver_iterations = report.iterations;
   timing.solve_ms = MillisecondsSince(start);
   VLOG(1) << "msckf t=" << frame.t_ns << ": " << added.size() << " landmarks, " << leaving.size()
-          << " states leaving, cost " << report.initial_cost << " -> " << report.final_cost;
+          << " states leaving, " << updates.size() << " updates (" << counts_.rejected << " rejected so far), cost "
+          << report.initial_cost << " -> " << report.final_cost;
 
   start = std::chrono::steady_clock::now();
   std::vector<LandmarkId> marginalized;
@@ -67,6 +73,14 @@ PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
   ForgetObservationsOf(leaving);
   timing.marginalize_ms = MillisecondsSince(start);
   return timing;
+}
+
+bool MsckfPolicy::Finish(Window& /*window*/) {
+  LOG(INFO) << "msckf tracks: " << counts_.used << " used (" << counts_.used_views << " views), " << counts_.rejected
+            << " rejected by triangulation (" << counts_.rejected_views << " views), " << counts_.too_short
+            << " too short; " << counts_.forgotten_views << " views left with their state unused";
+  LogPersistentCounts(persistent_);
+  return false;
 }
 
 // Re-anchoring after a tracking loss longer than the window: every state in
@@ -134,8 +148,8 @@ std::vector<MsckfPolicy::TrackUpdate> MsckfPolicy::PromoteTracks(const StereoFra
 
 // Tracks not seen in the newest frame give all their observations. Tracks
 // seen from a leaving state give all of them too and restart (whole_track),
-// or only their views from the leaving states when seen from every one of
-// them, and go on (leaving_views).
+// or only their views from the leaving states, and go on: when seen from
+// every leaving state (leaving_views) or from at least two (shared_views).
 std::vector<MsckfPolicy::TrackUpdate> MsckfPolicy::MatureTracks(const StereoFrame& frame,
                                                                 const std::vector<StateId>& leaving) {
   std::set<LandmarkId> seen_now;
@@ -169,14 +183,18 @@ std::vector<MsckfPolicy::TrackUpdate> MsckfPolicy::MatureTracks(const StereoFram
 }
 
 // Paper Algorithm 4, line 12: the track's views from the leaving states when
-// it was seen from each of them (removed from the track).
+// it was seen from each of them (leaving_views) or from at least two of them
+// (shared_views: a young track is rarely seen from the oldest leaving state,
+// and its views from the others would be lost); removed from the track.
 std::optional<MsckfPolicy::TrackUpdate> MsckfPolicy::LeavingViews(std::vector<Observation>& track, LandmarkId id,
                                                                   const std::vector<StateId>& leaving) const {
   TrackUpdate update{id, {}};
   for (const Observation& o : track) {
     if (IsLeaving(o.first, leaving)) update.observations.push_back(o);
   }
-  if (update.observations.size() != leaving.size() ||
+  const bool every_leaving_state = options_.msckf.msckf_leaving_update == "leaving_views";
+  const std::size_t needed = every_leaving_state ? leaving.size() : std::min<std::size_t>(2, leaving.size());
+  if (update.observations.size() < needed ||
       static_cast<int>(update.observations.size()) < options_.msckf.msckf_min_track_length) {
     return std::nullopt;
   }
@@ -187,23 +205,31 @@ std::optional<MsckfPolicy::TrackUpdate> MsckfPolicy::LeavingViews(std::vector<Ob
 }
 
 // Triangulates each update's observations and adds the landmark with them;
-// rejected ones are counted and their observations dropped.
+// rejected ones are counted and their observations dropped. The
+// reprojection gate is ReprojectionGate's, over this frame's tracks.
 std::vector<LandmarkId> MsckfPolicy::AddTriangulated(const std::vector<TrackUpdate>& updates, Window& window) {
   TriangulationOptions triangulation;
   triangulation.pixel_sigma = options_.model.pixel_sigma;
-  triangulation.max_reprojection_sigma = options_.msckf.msckf_max_reprojection;
+  triangulation.max_reprojection_sigma = MostReprojectionError(options_);
   triangulation.max_position_sigma_m = options_.msckf.msckf_max_landmark_sigma;
-  std::vector<LandmarkId> added;
+  std::vector<TriangulationResult> results;
   for (const TrackUpdate& update : updates) {
     std::vector<StereoView> views;
     for (const auto& [state, z] : update.observations) views.push_back({BodyPose(window.state(state)), z});
-    const TriangulationResult result = TriangulateMultiView(views, window.stereo(), triangulation);
-    if (!result.p_w) {
+    results.push_back(TriangulateMultiView(views, window.stereo(), triangulation));
+  }
+  const double gate = ReprojectionGate(results);
+  std::vector<LandmarkId> added;
+  for (std::size_t k = 0; k < updates.size(); ++k) {
+    const TrackUpdate& update = updates[k];
+    if (!results[k].p_w || results[k].max_error_sigma > gate) {
       ++counts_.rejected;
+      counts_.rejected_views += static_cast<int>(update.observations.size());
       persistent_.Release(update.id);
       continue;
     }
-    window.AddLandmark(update.id, *result.p_w);
+    window.AddLandmark(update.id, *results[k].p_w);
+    counts_.used_views += static_cast<int>(update.observations.size());
     for (const auto& [state, z] : update.observations) window.AddObservation(state, update.id, z);
     added.push_back(update.id);
     ++counts_.used;
@@ -211,14 +237,37 @@ std::vector<LandmarkId> MsckfPolicy::AddTriangulated(const std::vector<TrackUpda
   return added;
 }
 
+// The largest whitened reprojection error a track may have: at least
+// msckf_max_reprojection, and msckf_gate_median_factor times the median of
+// this frame's tracks (at least kMinTracksForMedian of them) when that is
+// larger: poses that drifted (IMU dead reckoning through a tracking loss or a
+// burst of dropped frames) raise every track's error, a wrong association
+// only its own. The raised gate stays within max_whitened_residual, the
+// window's own gate on observations.
+double MsckfPolicy::ReprojectionGate(const std::vector<TriangulationResult>& results) const {
+  constexpr std::size_t kMinTracksForMedian = 5;
+  const double absolute = options_.msckf.msckf_max_reprojection;
+  std::vector<double> errors;
+  for (const TriangulationResult& r : results) {
+    if (r.p_w) errors.push_back(r.max_error_sigma);
+  }
+  if (options_.msckf.msckf_gate_median_factor <= 0.0 || errors.size() < kMinTracksForMedian) return absolute;
+  std::nth_element(errors.begin(), errors.begin() + static_cast<std::ptrdiff_t>(errors.size() / 2), errors.end());
+  const double relative = options_.msckf.msckf_gate_median_factor * errors[errors.size() / 2];
+  return std::min(std::max(absolute, relative), MostReprojectionError(options_));
+}
+
 // Observations from marginalized states that no used track carried are lost
-// with them (only tracks too short to use).
+// with them (counted): views of tracks too short to use, or not seen from
+// enough leaving states (leaving_views: all of them; shared_views: two).
 void MsckfPolicy::ForgetObservationsOf(const std::vector<StateId>& leaving) {
   for (auto it = tracks_.begin(); it != tracks_.end();) {
     auto& observations = it->second;
+    const std::size_t before = observations.size();
     observations.erase(std::remove_if(observations.begin(), observations.end(),
                                       [&](const Observation& o) { return IsLeaving(o.first, leaving); }),
                        observations.end());
+    counts_.forgotten_views += static_cast<int>(before - observations.size());
     it = observations.empty() ? tracks_.erase(it) : std::next(it);
   }
 }

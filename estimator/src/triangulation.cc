@@ -66,10 +66,15 @@ TriangulationResult TriangulateMultiView(const std::vector<StereoView>& views, c
     if (it == options.iterations) break;
     *p_w -= H.ldlt().solve(g);
   }
-  if (max_error > options.max_reprojection_sigma) return {std::nullopt, TriangulationFailure::kReprojection};
+  result.max_error_sigma = max_error;
+  if (max_error > options.max_reprojection_sigma) {
+    result.failure = TriangulationFailure::kReprojection;
+    return result;
+  }
   const double min_information = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(H).eigenvalues()[0];
   if (!(min_information > 0) || 1.0 / std::sqrt(min_information) > options.max_position_sigma_m) {
-    return {std::nullopt, TriangulationFailure::kIllConditioned};
+    result.failure = TriangulationFailure::kIllConditioned;
+    return result;
   }
   result.p_w = p_w;
   return result;

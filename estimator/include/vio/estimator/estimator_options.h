@@ -59,23 +59,33 @@ struct MsckfOptions {
   int msckf_gn_steps = 1;                 ///< Gauss-Newton steps per MSCKF update [count]
   int msckf_min_track_length = 2;         ///< observations a track needs to be used [frames]
   double msckf_max_reprojection = 5.0;    ///< triangulation: largest whitened reprojection error [sigma]
+  /// The gate rises to this times the median error of the frame's tracks
+  /// (drifted poses raise them all); 0 = msckf_max_reprojection alone.
+  double msckf_gate_median_factor = 3.0;
   double msckf_max_landmark_sigma = 2.0;  ///< triangulation: largest position standard deviation [m]
   /// What a track seen from a leaving state contributes: whole_track (all its
-  /// observations; the track restarts) or leaving_views (paper Algorithm 4:
+  /// observations; the track restarts), leaving_views (paper Algorithm 4:
   /// only its views from the leaving states, when it was seen from all of
-  /// them; the track goes on without them).
-  std::string msckf_leaving_update = "leaving_views";
+  /// them; the track goes on without them) or shared_views (its views from the
+  /// leaving states when it was seen from at least two of them).
+  std::string msckf_leaving_update = "shared_views";
 
   template <class V>
   void Visit(V& v) {
     v("msckf_gn_steps", msckf_gn_steps, "MSCKF: Gauss-Newton steps per update (fixed_lag: to convergence) [count]", AtLeast(1));
     v("msckf_leaving_update", msckf_leaving_update,
       "MSCKF: a track seen from a leaving state is used whole and restarts (whole_track), or gives only its views "
-      "from the leaving states when seen from all of them and goes on (leaving_views, paper Algorithm 4)",
-      {"whole_track", "leaving_views"});
+      "from the leaving states and goes on: when seen from all of them (leaving_views, paper Algorithm 4) or from "
+      "at least two (shared_views: fewer views are lost with their state)",
+      {"whole_track", "leaving_views", "shared_views"});
     v("msckf_min_track_length", msckf_min_track_length, "MSCKF: observations a track needs to be used [frames]", AtLeast(2));
     v("msckf_max_reprojection", msckf_max_reprojection,
       "MSCKF triangulation: largest whitened reprojection error [sigma]", Positive());
+    v("msckf_gate_median_factor", msckf_gate_median_factor,
+      "MSCKF: the reprojection gate rises to this times the median error of the frame's tracks (at least 5 of "
+      "them) when larger, up to max_whitened_residual: poses that drifted through a tracking loss or dropped frames "
+      "raise every track's error, a wrong association only its own; 0 = msckf_max_reprojection alone []",
+      AtLeast(0));
     v("msckf_max_landmark_sigma", msckf_max_landmark_sigma,
       "MSCKF triangulation: largest landmark position standard deviation [m]", Positive());
   }

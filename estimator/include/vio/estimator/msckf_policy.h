@@ -13,9 +13,16 @@
 // evenly spaced states x_i, i mod 3 == 2 (1-based, oldest first), are
 // marginalized in the same step, after their observations were used: a track
 // seen from every leaving state gives those views (Algorithm 4, line 12) and
-// goes on without them (`leaving_views`), or, with `whole_track`, any track
-// seen from a leaving state is used whole and restarts. Older poses thin
-// out, so the window reaches arbitrarily far into the past.
+// goes on without them (`leaving_views`), or one seen from at least two of
+// them does (`shared_views`, the default: Algorithm 4 loses a young track's
+// views from the leaving states it was seen from), or, with `whole_track`,
+// any track seen from a leaving state is used whole and restarts. Older poses
+// thin out, so the window reaches arbitrarily far into the past.
+//
+// The triangulation's reprojection gate is msckf_max_reprojection, raised to
+// msckf_gate_median_factor times the median error of the frame's tracks: after
+// dead reckoning (a tracking loss, dropped frames) every track disagrees with
+// the drifted poses, and a fixed gate rejected them all for seconds.
 //
 // With persistent_landmarks > 0 (persistent_landmarks.h), a track about to
 // be used that was observed at least persistent_min_track times may be kept:
@@ -28,6 +35,7 @@
 
 #include "vio/estimator/persistent_landmarks.h"
 #include "vio/estimator/policy.h"
+#include "vio/estimator/triangulation.h"
 
 namespace vio {
 
@@ -36,6 +44,9 @@ struct MsckfCounts {
   int used = 0;             ///< tracks triangulated and marginalized
   int too_short = 0;        ///< ended with fewer observations than required
   int rejected = 0;         ///< triangulation rejected
+  int used_views = 0;       ///< observations in used tracks
+  int rejected_views = 0;   ///< observations in rejected tracks
+  int forgotten_views = 0;  ///< observations lost with their leaving state, never used
 };
 
 class MsckfPolicy final : public Policy {
@@ -45,10 +56,7 @@ class MsckfPolicy final : public Policy {
   MsckfPolicy(const EstimatorOptions& options, std::optional<int> gn_steps);
   PolicyTiming Update(const StereoFrame& frame, StateId new_state, Window& window) override;
   /// Logs the long-lived landmarks' counts; the trajectory is the filter's.
-  bool Finish(Window& /*window*/) override {
-    LogPersistentCounts(persistent_);
-    return false;
-  }
+  bool Finish(Window& /*window*/) override;
   const MsckfCounts& counts() const { return counts_; }
   const PersistentLandmarks& persistent() const { return persistent_; }
 
@@ -67,6 +75,7 @@ class MsckfPolicy final : public Policy {
   std::optional<TrackUpdate> LeavingViews(std::vector<Observation>& track, LandmarkId id,
                                           const std::vector<StateId>& leaving) const;
   std::vector<LandmarkId> AddTriangulated(const std::vector<TrackUpdate>& updates, Window& window);
+  double ReprojectionGate(const std::vector<TriangulationResult>& results) const;
   void ForgetObservationsOf(const std::vector<StateId>& leaving);
   std::optional<int> GaussNewtonSteps(const StereoFrame& frame);
 

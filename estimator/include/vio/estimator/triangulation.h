@@ -34,6 +34,9 @@ enum class TriangulationFailure { kNone, kNoDisparity, kBehindCamera, kReproject
 struct TriangulationResult {
   std::optional<Eigen::Vector3d> p_w;  ///< the point [m], when accepted
   TriangulationFailure failure = TriangulationFailure::kNone;
+  /// Largest whitened reprojection error of the refined point over the views
+  /// [sigma] (set when the refinement ran: accepted, kReprojection, kIllConditioned).
+  double max_error_sigma = 0.0;
 };
 
 TriangulationResult TriangulateMultiView(const std::vector<StereoView>& views, const RectifiedStereo& stereo,
