@@ -20,6 +20,9 @@ constexpr double kLooseVelocitySigma = 1.0;  // [m/s]
 constexpr double kLooseGyroBiasSigma = 0.1;  // [rad/s]
 // The free solve's |g| must be within this fraction of the model's.
 constexpr double kMaxGravityNormError = 0.2;
+// Noise of each chained stereo position in the linear alignment [m] (the
+// refinement then weighs every observation by model.pixel_sigma).
+constexpr double kStereoPositionSigma = 0.01;
 
 std::string CheckCoverage(const std::vector<StereoFrame>& frames, const std::vector<ImuSample>& imu) {
   std::ostringstream why;
@@ -175,9 +178,8 @@ DynamicInitResult InitializeDynamic(const std::vector<StereoFrame>& frames, cons
     bias.gyro = AlignGyroBias(motion.T_0_k, preintegrations);
     preintegrations = PreintegrateFrames(frames, imu, bias, calibration);
   }
-  const double position_sigma_m = 0.01;
   const VelocityGravity alignment = AlignVelocityGravity(motion.T_0_k, preintegrations, options.model.gravity,
-                                                         options.init.prior_accel_bias_sigma, position_sigma_m);
+                                                         options.init.prior_accel_bias_sigma, kStereoPositionSigma);
   if (std::abs(alignment.free_gravity_norm - options.model.gravity) > kMaxGravityNormError * options.model.gravity) {
     std::ostringstream why;
     why << "stereo motion and IMU disagree: the alignment's gravity is " << alignment.free_gravity_norm
