@@ -1,9 +1,13 @@
 #include "vio/estimator/estimator.h"
 
+#include <algorithm>
 #include <chrono>
 #include <iomanip>
+#include <sstream>
 
 #include <glog/logging.h>
+
+#include "vio/estimator/dynamic_initializer.h"
 
 namespace vio {
 Estimator::Estimator(const EstimatorOptions& options, const ImuCalibration& imu, const RectifiedStereo& stereo)
@@ -53,34 +57,111 @@ bool Estimator::Initialize(const StereoFrame& frame) {
   if (given_initial_state_) {
     InitialState initial = *given_initial_state_;
     initial.t_ns = frame.t_ns;
-    AddFirstState(initial);
+    AddFirstState(initial, DefaultFirstPrior(initial.q_w_b));
+    init_method_ = "groundtruth";
     return true;
   }
-  const StaticInitResult result = InitializeStatic(imu_, frame.t_ns, options_.init);
-  if (!result.state) {
-    if (result.moving && !waiting_while_moving_) {
-      LOG(WARNING) << "waiting for static initialization: " << result.reason << "; waiting until it is still";
+  const InitOptions& o = options_.init;
+  const double kept_s = std::max(o.static_window_s, o.dynamic_window_s) + 0.1;
+  init_frames_.erase(std::remove_if(init_frames_.begin(), init_frames_.end(),
+                                    [&](const StereoFrame& f) { return f.t_ns < frame.t_ns - SecondsToNanos(kept_s); }),
+                     init_frames_.end());
+  init_frames_.push_back(frame);
+  std::string static_reason, dynamic_reason;
+  bool moving = o.init == "dynamic";
+  if (o.init != "dynamic") {
+    if (const std::optional<InitialState> state = TryStatic(frame, &static_reason, &moving)) {
+      AddFirstState(*state, DefaultFirstPrior(state->q_w_b));
+      init_method_ = "static";
+      for (const StereoFrame& f : InitFrames(frame.t_ns, o.static_window_s)) {
+        if (f.t_ns == frame.t_ns) continue;
+        InitialState at_rest = *state;
+        at_rest.t_ns = f.t_ns;
+        earlier_estimates_.push_back(EstimateOfInitial(at_rest));
+        left_window_.push_back(earlier_estimates_.back());
+      }
+      init_frames_.clear();
+      return true;
     }
-    waiting_while_moving_ = result.moving;
-    waiting_reason_ = result.reason;
-    return false;
+  }
+  if (moving && o.init != "static" && TryDynamic(&dynamic_reason)) return true;
+  const std::string reason = o.init == "static"    ? static_reason
+                             : o.init == "dynamic" ? dynamic_reason
+                             : !moving             ? "static: " + static_reason
+                                                   : "static: " + static_reason + "; dynamic: " + dynamic_reason;
+  if (moving && !waiting_while_moving_) LOG(WARNING) << "waiting for initialization: " << reason;
+  waiting_while_moving_ = moving;
+  waiting_reason_ = reason;
+  return false;
+}
+
+std::optional<InitialState> Estimator::TryStatic(const StereoFrame& frame, std::string* reason, bool* moving) const {
+  const StaticInitResult result = InitializeStatic(imu_, frame.t_ns, options_.init);
+  *moving = result.moving;
+  *reason = result.reason;
+  if (!result.state || options_.init.init != "auto") return result.state;
+  // The IMU can be still while the rig glides at constant velocity: the camera decides.
+  const std::optional<double> moved = CameraPixelMotion(InitFrames(frame.t_ns, options_.init.static_window_s),
+                                                        options_.init.dynamic_min_landmarks);
+  if (moved && *moved > options_.init.static_max_camera_motion_px) {
+    std::ostringstream why;
+    why << "the IMU is still but the image moved " << *moved << " px (median over the landmarks) in the last "
+        << options_.init.static_window_s << " s (limit static_max_camera_motion_px = "
+        << options_.init.static_max_camera_motion_px << ")";
+    *reason = why.str();
+    *moving = true;
+    LOG(INFO) << "no static initialization: " << *reason;
+    return std::nullopt;
   }
   LOG(INFO) << "static initialization at t=" << std::fixed << std::setprecision(3) << NanosToSeconds(frame.t_ns)
             << " s";
-  AddFirstState(*result.state);
+  return result.state;
+}
+
+bool Estimator::TryDynamic(std::string* reason) {
+  const InitOptions& o = options_.init;
+  const std::vector<StereoFrame> frames = InitFrames(init_frames_.back().t_ns, o.dynamic_window_s);
+  const double span_s = NanosToSeconds(frames.back().t_ns - frames.front().t_ns);
+  if (span_s < 0.9 * o.dynamic_window_s - 1e-3) {  // 10 % short (a dropped frame), and round-off
+    std::ostringstream why;
+    why << "collecting frames (" << span_s << " of " << o.dynamic_window_s << " s)";
+    *reason = why.str();
+    return false;
+  }
+  const DynamicInitResult result = InitializeDynamic(frames, imu_, imu_calibration_, window_.stereo(), options_);
+  if (!result.state) {
+    *reason = result.reason;
+    return false;
+  }
+  LOG(INFO) << "dynamic initialization at t=" << std::fixed << std::setprecision(3)
+            << NanosToSeconds(result.state->t_ns) << " s from " << frames.size() << " frames (" << span_s
+            << " s): |v| " << result.state->v_w_b.norm() << " m/s, gyro bias " << result.state->gyro_bias.transpose()
+            << " rad/s, accel bias " << result.state->accel_bias.transpose() << " m/s^2; sigmas (v, b_g, b_a) "
+            << result.prior.speed_bias_sigma.transpose();
+  AddFirstState(*result.state, result.prior_covariance);
+  init_method_ = "dynamic";
+  for (const InitialState& earlier : result.earlier) {
+    earlier_estimates_.push_back(EstimateOfInitial(earlier));
+    left_window_.push_back(earlier_estimates_.back());
+  }
+  init_frames_.clear();
   return true;
 }
 
-void Estimator::AddFirstState(const InitialState& initial) {
-  last_state_ = StateId(next_state_id_++);
-  State& s = window_.AddState(last_state_, initial.t_ns);
-  s.SetPose(initial.p_w_b, initial.q_w_b);
-  s.SetSpeedBias(initial.v_w_b, initial.gyro_bias, initial.accel_bias);
+std::vector<StereoFrame> Estimator::InitFrames(Timestamp t_ns, double span_s) const {
+  std::vector<StereoFrame> frames;
+  for (const StereoFrame& f : init_frames_) {
+    if (f.t_ns >= t_ns - SecondsToNanos(span_s) && f.t_ns <= t_ns) frames.push_back(f);
+  }
+  return frames;
+}
+
+StatePrior Estimator::DefaultFirstPrior(const Eigen::Quaterniond& q_w_b) const {
   const InitOptions& o = options_.init;
   StatePrior prior;
   // Roll/pitch and yaw are world-frame angles; the tangent's rotation is in
   // the body frame: Sigma_body = R_w_b^T Sigma_world R_w_b.
-  const Eigen::Matrix3d R_w_b = initial.q_w_b.toRotationMatrix();
+  const Eigen::Matrix3d R_w_b = q_w_b.toRotationMatrix();
   const Eigen::Vector3d rotation_sigma_w(o.prior_tilt_sigma, o.prior_tilt_sigma, o.prior_yaw_sigma);
   prior.pose_covariance.setZero();
   prior.pose_covariance.topLeftCorner<3, 3>() =
@@ -89,6 +170,27 @@ void Estimator::AddFirstState(const InitialState& initial) {
       R_w_b.transpose() * rotation_sigma_w.cwiseAbs2().asDiagonal() * R_w_b;
   prior.speed_bias_sigma << Eigen::Vector3d::Constant(o.prior_velocity_sigma),
       Eigen::Vector3d::Constant(o.prior_gyro_bias_sigma), Eigen::Vector3d::Constant(o.prior_accel_bias_sigma);
+  return prior;
+}
+
+void Estimator::AddFirstState(const InitialState& initial, const Eigen::Matrix<double, 15, 15>& covariance) {
+  last_state_ = StateId(next_state_id_++);
+  State& s = window_.AddState(last_state_, initial.t_ns);
+  s.SetPose(initial.p_w_b, initial.q_w_b);
+  s.SetSpeedBias(initial.v_w_b, initial.gyro_bias, initial.accel_bias);
+  // A Gaussian prior N(x0, covariance) as a linear factor: jacobian = covariance^-1/2, residual 0.
+  const Eigen::Matrix<double, 15, 15> information = covariance.inverse();
+  const Eigen::LLT<Eigen::Matrix<double, 15, 15>> llt(0.5 * (information + information.transpose()));
+  CHECK(llt.info() == Eigen::Success) << "the dynamic initializer's covariance is not positive definite";
+  window_.AddLinearFactor({last_state_}, {}, llt.matrixU().toDenseMatrix(), Eigen::VectorXd::Zero(15));
+  waiting_reason_.clear();
+}
+
+void Estimator::AddFirstState(const InitialState& initial, const StatePrior& prior) {
+  last_state_ = StateId(next_state_id_++);
+  State& s = window_.AddState(last_state_, initial.t_ns);
+  s.SetPose(initial.p_w_b, initial.q_w_b);
+  s.SetSpeedBias(initial.v_w_b, initial.gyro_bias, initial.accel_bias);
   window_.AddStatePrior(last_state_, prior);
   waiting_reason_.clear();
 }
@@ -142,6 +244,18 @@ std::vector<FrameEstimate> Estimator::LastEstimates() const {
   std::vector<FrameEstimate> last = left_window_;
   for (const auto& [id, s] : window_.states()) last.push_back(EstimateOf(s));
   return last;
+}
+
+FrameEstimate Estimator::EstimateOfInitial(const InitialState& s) {
+  FrameEstimate e;
+  e.t_ns = s.t_ns;
+  e.initialized = true;
+  e.p_w_b = s.p_w_b;
+  e.q_w_b = s.q_w_b;
+  e.v_w_b = s.v_w_b;
+  e.gyro_bias = s.gyro_bias;
+  e.accel_bias = s.accel_bias;
+  return e;
 }
 
 FrameEstimate Estimator::EstimateOf(const State& s) const {

@@ -50,6 +50,14 @@ StaticInitResult InitializeStatic(const std::vector<ImuSample>& imu, Timestamp t
         << NanosToSeconds(t_ns) << " s";
     return {std::nullopt, why.str()};
   }
+  // Motion is judged on the samples there are: a start in motion is known
+  // as one before the window is full.
+  if (s.gyro_std > options.static_max_gyro_std || s.accel_std > options.static_max_accel_std) {
+    why << "the IMU is moving at t=" << NanosToSeconds(t_ns) << " s (gyro std " << s.gyro_std << " rad/s, limit "
+        << options.static_max_gyro_std << "; accel std " << s.accel_std << " m/s^2, limit "
+        << options.static_max_accel_std << ")";
+    return {std::nullopt, why.str(), /*moving=*/true};
+  }
   // The samples must span the window asked for (a few periods short at most),
   // not just its last tenth.
   const double covered_s = NanosToSeconds(s.last_ns - s.first_ns);
@@ -57,12 +65,6 @@ StaticInitResult InitializeStatic(const std::vector<ImuSample>& imu, Timestamp t
     why << "the IMU does not cover " << kMinCoveredFraction * 100 << "% of the " << options.static_window_s
         << " s static window before the frame yet";
     return {std::nullopt, why.str()};
-  }
-  if (s.gyro_std > options.static_max_gyro_std || s.accel_std > options.static_max_accel_std) {
-    why << "the IMU is moving at t=" << NanosToSeconds(t_ns) << " s (gyro std " << s.gyro_std << " rad/s, limit "
-        << options.static_max_gyro_std << "; accel std " << s.accel_std << " m/s^2, limit "
-        << options.static_max_accel_std << ")";
-    return {std::nullopt, why.str(), /*moving=*/true};
   }
   InitialState state;
   state.t_ns = t_ns;

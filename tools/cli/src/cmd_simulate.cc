@@ -18,6 +18,10 @@
 DEFINE_string(from, "", "hybrid mode: real EuRoC ASL folder whose IMU, ground truth and calibration are used");
 DEFINE_double(from_duration_s, 0.0, "hybrid mode: only the camera frames of the first S seconds of the sequence "
               "(0: all) [s]");
+DEFINE_double(from_start_s, 0.0, "hybrid mode: cut the sequence S seconds after its first camera frame (camera, "
+              "IMU and ground truth), e.g. to start in flight [s]");
+DEFINE_double(flight_start_s, 0.0, "synthetic: how far along the flight t = 0 is: 0 starts at rest (the 3 s static "
+              "start, then a 2 s ramp), 5 or more starts at full pace [s]");
 DEFINE_string(groundtruth_jumps, "remove", "hybrid mode: ground-truth steps that disagree with its own velocity by "
               "more than 5 m/s (EuRoC MH_04 has one of 14 cm in 5 ms at 45 s): remove (the ground truth from then on "
               "is moved back by what its velocity does not explain, so the cameras move as the real IMU does; the "
@@ -114,6 +118,8 @@ SimulatorOptions OptionsFromFlags() {
   options.output_dir = FLAGS_output_dir;
   options.from_euroc_dir = FLAGS_from;
   options.from_duration_s = FLAGS_from_duration_s;
+  options.from_start_s = FLAGS_from_start_s;
+  options.trajectory.start_offset_s = FLAGS_flight_start_s;
   options.keep_groundtruth_jumps = ParseKeepJumps(FLAGS_groundtruth_jumps);
   options.camera_output = ParseCameraOutput(FLAGS_camera);
   options.seed = FLAGS_seed;

@@ -151,6 +151,22 @@ void CountFrameGaps(const FrameSource& source, RunResult* result) {
   }
 }
 
+// At the first estimate: the initializer's estimates of earlier frames
+// (they stop counting as waiting), and how long the run waited.
+void AddEarlierEstimates(Estimator& estimator, Timestamp first_covered_ns, Timestamp t_ns, RunOutput& output,
+                         RunResult* result) {
+  Timestamp first_ns = t_ns;
+  for (const FrameEstimate& earlier : estimator.TakeEarlierEstimates()) {
+    if (earlier.t_ns < first_covered_ns || earlier.t_ns >= t_ns) continue;
+    output.AddFrame(earlier);
+    ++result->frames_estimated;
+    --result->health.frames_waiting_init;
+    first_ns = std::min(first_ns, earlier.t_ns);
+  }
+  result->init.method = estimator.init_method();
+  result->init.wait_s = NanosToSeconds(first_ns - first_covered_ns);
+}
+
 // The frame loop: IMU, (ground-truth start), front end, estimator, output.
 // Bad data mid-run ends the loop with a status; what was estimated is kept.
 // `observations` (null: none written) receives every frame the estimator is given.
@@ -161,10 +177,12 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
                                                : ProgressBar(num_frames, "frames", nullptr, false);
   const bool init_from_gt = request.config.estimator.init.init == "groundtruth";
   ImuCursor imu{dataset, request.config.estimator.model.max_imu_gap_s};
+  Timestamp first_covered_ns = -1;  // the first frame the IMU covers
   for (size_t k = 0; k < source.size(); ++k) {
     const Timestamp t_ns = source.time(k);
     if (dataset.imu.empty() || t_ns < dataset.imu.front().t_ns) continue;  // counted by ReportFramesOutsideImu
     if (t_ns > dataset.imu.back().t_ns) break;
+    if (first_covered_ns < 0) first_covered_ns = t_ns;
     try {
       if (auto gap = imu.FeedUpTo(t_ns, result->frames_estimated > 0, &estimator)) {
         StopAt(k, source.size(), "imu_gap", *gap, result);
@@ -186,8 +204,10 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
       progress.Update(static_cast<std::int64_t>(k + 1));
       if (!estimate.initialized) {
         ++result->health.frames_waiting_init;
+        result->init.last_reason = estimator.waiting_reason();
         continue;
       }
+      if (result->frames_estimated == 0) AddEarlierEstimates(estimator, first_covered_ns, t_ns, output, result);
       if (Diverged(estimate)) {
         StopAt(k, source.size(), "diverged",
                "estimate diverged at t=" + std::to_string(NanosToSeconds(estimate.t_ns)) + " s (frame " +
@@ -224,6 +244,23 @@ void FinishEstimates(Estimator& estimator, RunOutput& output, RunResult* result)
   }
 }
 
+// A run that waited more than kMaxInitWaitS or kMaxInitWaitFraction of its
+// frames before its first estimate lost that part of the trajectory: not ok.
+void CheckLateInit(RunResult* result) {
+  result->init.wait_frames = result->health.frames_waiting_init;
+  if (result->frames_estimated == 0 || result->frames == 0) return;
+  const double fraction = static_cast<double>(result->init.wait_frames) / result->frames;
+  if (result->init.wait_s <= kMaxInitWaitS && fraction <= kMaxInitWaitFraction) return;
+  std::ostringstream why;
+  why << std::fixed << std::setprecision(2) << "late initialization (" << result->init.method << "): waited "
+      << result->init.wait_s << " s and " << result->init.wait_frames << " frames (" << 100 * fraction
+      << "% of the run; limits " << kMaxInitWaitS << " s, " << 100 * kMaxInitWaitFraction
+      << "%) before the first estimate; those frames are not estimated; last reason: " << result->init.last_reason;
+  LOG(WARNING) << why.str();
+  result->problems.push_back(why.str());
+  if (result->status == "ok") result->status = "late_init";
+}
+
 // Counts from the estimator, and the statuses that need the whole run.
 void FinishStatus(const Estimator& estimator, RunResult* result) {
   result->health.rejected_observations = estimator.rejected_observations();
@@ -232,6 +269,7 @@ void FinishStatus(const Estimator& estimator, RunResult* result) {
   result->health.rejected_steps = estimator.window().health().rejected_steps;
   result->health.dropped_observations = estimator.window().health().dropped_observations;
   if (result->frames_estimated == 0 && result->status == "ok") result->status = "not_initialized";
+  CheckLateInit(result);
   if (result->health.failed_solves > 0) {
     result->problems.push_back(std::to_string(result->health.failed_solves) +
                                " solves ended without a usable solution");

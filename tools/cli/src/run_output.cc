@@ -124,6 +124,8 @@ void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_jso
       << r.tracking.losses_beyond_window << ", \"longest_s\": " << JsonNumber(r.tracking.longest_loss_s)
       << "},\n  \"frontend\": " << frontend_json;
   if (!waiting_reason.empty()) out << ",\n  \"not_initialized_reason\": " << JsonString(waiting_reason);
+  out << ",\n  \"init\": {\"method\": " << JsonString(r.init.method) << ", \"wait_s\": " << JsonNumber(r.init.wait_s)
+      << ", \"wait_frames\": " << r.init.wait_frames << ", \"last_reason\": " << JsonString(r.init.last_reason) << "}";
   if (r.groundtruth_tilt_deg) out << ",\n  \"groundtruth_tilt_deg\": " << JsonNumber(*r.groundtruth_tilt_deg);
   if (r.evaluation) {
     std::string evaluation = ToJson(*r.evaluation);

@@ -1,5 +1,6 @@
 #include "vio/simulator/simulator.h"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <iomanip>
@@ -38,6 +39,9 @@ void CheckOptions(const SimulatorOptions& options) {
   if (options.from_euroc_dir.empty() && !(options.duration_s > 0.0)) {
     throw std::invalid_argument("simulator: duration must be positive, got " +
                                 std::to_string(options.duration_s) + " s");
+  }
+  if (!(options.from_start_s >= 0.0)) {
+    throw std::invalid_argument("simulator: from_start_s must be >= 0, got " + std::to_string(options.from_start_s));
   }
   if (!(options.from_duration_s >= 0.0)) {
     throw std::invalid_argument("simulator: from_duration_s must be >= 0 (0: the whole sequence), got " +
@@ -119,6 +123,30 @@ void WarnOfGroundTruthJumps(const SimulatorOptions& options, const std::vector<G
   }
 }
 
+// Index of the last sample at or before t_ns (0 when none): what is kept
+// from there on covers the first frame at or after t_ns.
+template <class Sample>
+std::ptrdiff_t FirstKept(Timestamp t_ns, const std::vector<Sample>& samples) {
+  auto it = std::lower_bound(samples.begin(), samples.end(), t_ns,
+                             [](const Sample& s, Timestamp t) { return s.t_ns < t; });
+  if (it != samples.begin() && (it == samples.end() || it->t_ns > t_ns)) --it;
+  return it - samples.begin();
+}
+
+// The IMU and ground truth before the cut are removed.
+void CutHybridStart(Timestamp t_ns, EurocDataset* dataset) {
+  if (dataset->frames[0].back().t_ns < t_ns) {
+    throw std::invalid_argument("simulator: from_start_s is past the sequence's last camera frame");
+  }
+  const std::ptrdiff_t imu_kept = FirstKept(t_ns, dataset->imu);
+  if (dataset->imu_lines.size() == dataset->imu.size()) {
+    dataset->imu_lines.erase(dataset->imu_lines.begin(), dataset->imu_lines.begin() + imu_kept);
+  }
+  dataset->imu.erase(dataset->imu.begin(), dataset->imu.begin() + imu_kept);
+  dataset->groundtruth.erase(dataset->groundtruth.begin(),
+                             dataset->groundtruth.begin() + FirstKept(t_ns, dataset->groundtruth));
+}
+
 void BuildHybridMotion(const SimulatorOptions& options, Simulation* sim) {
   EurocReadOptions read;
   read.read_features = false;
@@ -136,8 +164,11 @@ void BuildHybridMotion(const SimulatorOptions& options, Simulation* sim) {
   dataset.root.clear();
   dataset.features.clear();
   dataset.has_images = false;
-  const Timestamp first_ns = dataset.frames[0].front().t_ns;
+  sim->scene_path = PathOf(dataset.groundtruth);
+  const Timestamp first_ns = dataset.frames[0].front().t_ns + SecondsToNanos(options.from_start_s);
+  if (options.from_start_s > 0.0) CutHybridStart(first_ns, &dataset);
   for (const CameraFrame& row : dataset.frames[0]) {
+    if (row.t_ns < first_ns) continue;
     if (options.from_duration_s > 0.0 && row.t_ns - first_ns > SecondsToNanos(options.from_duration_s)) break;
     if (const std::optional<Eigen::Isometry3d> T_w_b = InterpolatePose(dataset.groundtruth, row.t_ns)) {
       sim->frames.push_back({row.t_ns, *T_w_b});
@@ -256,7 +287,8 @@ Simulation BuildSimulation(const SimulatorOptions& options) {
   sim.frames = DropFrames(sim.frames, options.gaps, &gap_rng);
   sim.dataset.frames[0] = FrameRows(sim.frames);
   sim.dataset.frames[1] = sim.dataset.frames[0];
-  sim.scene = BuildScene(options.scene, PathOf(sim.dataset.groundtruth), &rng);
+  if (sim.scene_path.empty()) sim.scene_path = PathOf(sim.dataset.groundtruth);
+  sim.scene = BuildScene(options.scene, sim.scene_path, &rng);
   if (options.camera_output == SimCameraOutput::kFeatures) {
     sim.features = SimulateFeatures(sim.scene, {sim.dataset.cameras[0], sim.dataset.cameras[1]}, sim.frames,
                                     options.features, noise_rng);

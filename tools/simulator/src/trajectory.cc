@@ -94,10 +94,10 @@ Eigen::Vector3d PositionShapeDerivative(double u, const Eigen::Vector3d& half_ex
 void CheckOptions(const SyntheticTrajectoryOptions& options) {
   if (!(options.half_extent_m.minCoeff() >= 0.0) || !(options.max_speed_m_s > 0.0) ||
       !(options.max_rotation_rate_rad_s > 0.0) || !(options.ramp_duration_s > 0.0) ||
-      !(options.static_duration_s >= 0.0)) {
+      !(options.static_duration_s >= 0.0) || !(options.start_offset_s >= 0.0)) {
     throw std::invalid_argument(
         "synthetic trajectory: need extents >= 0, max speed > 0, max rotation rate > 0, ramp > 0 "
-        "and static duration >= 0");
+        "and static duration and start offset >= 0");
   }
 }
 
@@ -129,7 +129,7 @@ SyntheticTrajectory::SyntheticTrajectory(const SyntheticTrajectoryOptions& optio
 
 SyntheticTrajectory::Phase SyntheticTrajectory::WarpTime(double t_s) const {
   const double k = 2.0 * M_PI / period_s_;
-  const double tau = t_s - options_.static_duration_s;
+  const double tau = t_s + options_.start_offset_s - options_.static_duration_s;
   const double ramp = options_.ramp_duration_s;
   Phase phase;
   if (tau <= 0.0) return phase;

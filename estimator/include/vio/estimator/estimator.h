@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "vio/estimator/estimator_options.h"
@@ -72,8 +73,15 @@ class Estimator {
   std::optional<StateCovariance> NewestCovariance() { return NewestStateCovariance(window_); }
   /// Frames lost to too few observations (propagated on the IMU).
   const TrackingReport& tracking() const { return tracking_.report(); }
-  /// Why static initialization has not happened yet (empty once initialized).
+  /// Why initialization has not happened yet (empty once initialized).
   const std::string& waiting_reason() const { return waiting_reason_; }
+  /// The initializer's estimates of frames before the first state (time order), once, after the
+  /// frame that initialized: static, the frames of the still IMU window (at the first state's pose,
+  /// at rest); dynamic, the refinement's estimates of the window's earlier frames. Not re-estimated
+  /// by the window (their information is in the first state's prior).
+  std::vector<FrameEstimate> TakeEarlierEstimates() { return std::exchange(earlier_estimates_, {}); }
+  /// How the run started: static, dynamic or groundtruth (empty before initialization).
+  const std::string& init_method() const { return init_method_; }
   /// Observations rejected by the whitened-residual gate (model.max_whitened_residual).
   int rejected_observations() const { return rejected_observations_; }
 
@@ -86,11 +94,22 @@ class Estimator {
   };
   Prediction Predict(Timestamp t_ns) const;
   bool Initialize(const StereoFrame& frame);
-  void AddFirstState(const InitialState& initial);
+  /// Static initialization at the frame; auto: only when the camera agrees that it is still.
+  /// `moving`: the IMU (or, auto, the camera) moves.
+  std::optional<InitialState> TryStatic(const StereoFrame& frame, std::string* reason, bool* moving) const;
+  /// Dynamic initialization from the buffered frames ending at this one.
+  bool TryDynamic(std::string* reason);
+  /// The buffered frames (time order) from t_ns - span_s on.
+  std::vector<StereoFrame> InitFrames(Timestamp t_ns, double span_s) const;
+  void AddFirstState(const InitialState& initial, const StatePrior& prior);
+  /// The first state under a full 15x15 prior over [pose, speed_bias] (dynamic initialization).
+  void AddFirstState(const InitialState& initial, const Eigen::Matrix<double, 15, 15>& covariance);
+  StatePrior DefaultFirstPrior(const Eigen::Quaterniond& q_w_b) const;
   void AddPropagatedState(Timestamp t_ns);
   StereoFrame GateObservations(const StereoFrame& frame);
   FrameEstimate Estimate(const StereoFrame& frame) const;
   FrameEstimate EstimateOf(const State& state) const;
+  static FrameEstimate EstimateOfInitial(const InitialState& state);
   void PruneImu(Timestamp before_ns);
 
   EstimatorOptions options_;
@@ -106,6 +125,9 @@ class Estimator {
   int rejected_observations_ = 0;
   std::vector<FrameEstimate> left_window_;  ///< states that left the window, as they left
   bool waiting_while_moving_ = false;  ///< the IMU moved at the last frame before initialization
+  std::vector<StereoFrame> init_frames_;  ///< frames before initialization (the last few seconds)
+  std::string init_method_;
+  std::vector<FrameEstimate> earlier_estimates_;
 };
 
 }  // namespace vio

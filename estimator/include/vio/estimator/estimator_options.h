@@ -203,7 +203,7 @@ struct ModelOptions {
 
 /// How the first state is found.
 struct InitOptions {
-  std::string init = "static";          ///< static (IMU stillness) or groundtruth
+  std::string init = "auto";            ///< auto | static (IMU stillness) | dynamic (moving start) | groundtruth
   double static_window_s = 1.0;         ///< IMU span averaged for the initial biases (static: also gravity) [s]
   double static_max_gyro_std = 0.05;    ///< stillness: largest gyro standard deviation [rad/s]
   double static_max_accel_std = 0.8;    ///< stillness: largest accel standard deviation [m/s^2]
@@ -213,10 +213,19 @@ struct InitOptions {
   double prior_velocity_sigma = 0.05;   ///< first-state prior on velocity [m/s]
   double prior_gyro_bias_sigma = 0.01;  ///< first-state prior on the gyro bias [rad/s]
   double prior_accel_bias_sigma = 0.2;  ///< first-state prior on the accel bias [m/s^2]
+  double static_max_camera_motion_px = 3.0;  ///< auto: a static start needs the image this still [px]
+  double dynamic_window_s = 0.5;        ///< dynamic: span of the frames the first state is solved from [s]
+  int dynamic_min_landmarks = 15;       ///< dynamic: landmarks with stereo depth shared by consecutive frames
+  double dynamic_max_tilt_sigma = 0.05;     ///< dynamic: largest roll/pitch standard deviation to start [rad]
+  double dynamic_max_velocity_sigma = 0.2;  ///< dynamic: largest velocity standard deviation to start [m/s]
 
   template <class V>
   void Visit(V& v) {
-    v("init", init, "initialization: static (IMU stillness) or groundtruth", {"static", "groundtruth"});
+    v("init", init,
+      "initialization: auto (static when the IMU and the camera are still, dynamic otherwise, whichever is ready "
+      "first), static (IMU stillness), dynamic (from motion: stereo poses aligned with the preintegrated IMU, "
+      "refined by a small bundle adjustment) or groundtruth",
+      {"auto", "static", "dynamic", "groundtruth"});
     v("static_window_s", static_window_s,
       "IMU span averaged for the initial biases (static: also gravity; groundtruth: either side of the start) [s]",
       Positive());
@@ -228,6 +237,18 @@ struct InitOptions {
     v("prior_velocity_sigma", prior_velocity_sigma, "first-state prior on velocity [m/s]", Positive());
     v("prior_gyro_bias_sigma", prior_gyro_bias_sigma, "first-state prior on the gyro bias [rad/s]", Positive());
     v("prior_accel_bias_sigma", prior_accel_bias_sigma, "first-state prior on the accel bias [m/s^2]", Positive());
+    v("static_max_camera_motion_px", static_max_camera_motion_px,
+      "auto: a static start also needs the image to move less than this over the static window (median "
+      "displacement of the tracked landmarks) [px]",
+      Positive());
+    v("dynamic_window_s", dynamic_window_s, "dynamic: span of the frames the first state is solved from [s]",
+      Positive());
+    v("dynamic_min_landmarks", dynamic_min_landmarks,
+      "dynamic: landmarks with stereo depth each pair of consecutive frames must share [count]", AtLeast(3));
+    v("dynamic_max_tilt_sigma", dynamic_max_tilt_sigma,
+      "dynamic: the run starts once roll and pitch are known to this standard deviation [rad]", Positive());
+    v("dynamic_max_velocity_sigma", dynamic_max_velocity_sigma,
+      "dynamic: the run starts once the velocity is known to this standard deviation [m/s]", Positive());
   }
 };
 

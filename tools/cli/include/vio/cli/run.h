@@ -49,12 +49,27 @@ struct RunHealth {
   int dropped_observations = 0;   ///< observations that failed at a rejected step's end point: dropped as outliers
 };
 
+/// A run that waits longer than this, or for more than this fraction of its frames, before its first
+/// estimate has status late_init.
+inline constexpr double kMaxInitWaitS = 2.0;
+inline constexpr double kMaxInitWaitFraction = 0.05;
+
+/// How the run started.
+struct InitReport {
+  std::string method;    ///< static, dynamic or groundtruth; empty when the run never started
+  double wait_s = 0;     ///< from the first frame the IMU covers to the first estimate [s]
+  int wait_frames = 0;   ///< frames before the first estimate (= health.frames_waiting_init)
+  std::string last_reason;  ///< why it was still waiting at the last frame before it started
+};
+
 struct RunResult {
   /// ok: every frame from initialization on estimated, every solve usable,
   /// within the sanity bounds; else the first of: imu_gap (stopped at an IMU
   /// gap longer than model.max_imu_gap_s), diverged (|p| > 10 km, |v| > 100
   /// m/s or not finite), failed (an error mid-run), frames_skipped (frames
-  /// outside the IMU span by more than max_imu_gap_s), not_initialized,
+  /// outside the IMU span by more than max_imu_gap_s), not_initialized (no
+  /// frame estimated), late_init (more than kMaxInitWaitS seconds or
+  /// kMaxInitWaitFraction of the frames waited for initialization),
   /// solver_failure, drifted (ATE RMSE > 0.5 m + 5% of the path). Not ok =
   /// exit code 1 of `vio run`; what was estimated is written either way.
   std::string status = "ok";
@@ -71,6 +86,7 @@ struct RunResult {
   int frame_gaps = 0;             ///< frame intervals longer than 1.5 median intervals (missing frames)
   double longest_frame_gap_s = 0; ///< longest frame interval [s]
   TrackingReport tracking;        ///< frames with too few observations (propagated on the IMU)
+  InitReport init;
   std::optional<TrajectoryEvaluation> evaluation;  ///< when ground truth exists
   std::optional<NeesResult> nees;  ///< with output_covariance, when ground truth exists (same alignment)
 };

@@ -43,8 +43,12 @@ struct SimulatorOptions {
   std::string output_dir;
   /// ASL folder of a real sequence for hybrid mode; empty = synthetic.
   std::string from_euroc_dir;
-  /// Hybrid mode: camera frames of the first this many seconds only (0: all) [s].
+  /// Hybrid mode: camera frames of the first this many seconds only (0: all), counted from
+  /// from_start_s [s].
   double from_duration_s = 0.0;
+  /// Hybrid mode: the sequence is cut this many seconds after its first camera frame (camera, IMU
+  /// and ground truth), e.g. to start in flight [s].
+  double from_start_s = 0.0;
   /// Hybrid mode: ground-truth steps that disagree with the ground truth's own
   /// velocity by more than 5 m/s (a glitch of the reference: EuRoC MH_04 has
   /// one of 14 cm in 5 ms) are removed (RemoveGroundTruthJumps: the cameras and
@@ -95,6 +99,9 @@ struct Simulation {
   std::vector<FramePose> frames;   ///< body pose at each camera frame
   FeatureSimulation features;      ///< per-frame counts and track lengths (features mode)
   std::vector<GroundTruthJump> groundtruth_jumps;  ///< hybrid: the source ground truth's jumps (removed unless kept)
+  /// The path the room and landmarks are built around: the whole ground truth, also when the
+  /// sequence is cut (from_start_s), so a cut sequence flies through the same world.
+  std::vector<Eigen::Vector3d> scene_path;
 };
 
 struct SimulationSummary {

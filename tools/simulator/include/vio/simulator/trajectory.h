@@ -44,6 +44,10 @@ struct SyntheticTrajectoryOptions {
   Eigen::Vector3d half_extent_m = Eigen::Vector3d(2.5, 2.5, 0.8);
   /// Initial period at rest [s].
   double static_duration_s = 3.0;
+  /// How far along the flight t = 0 is [s]: 0 starts at rest (the static
+  /// period, then the ramp); static_duration_s + ramp_duration_s or more
+  /// starts at full pace.
+  double start_offset_s = 0.0;
   /// Smooth acceleration from rest to full pace [s].
   double ramp_duration_s = 2.0;
   /// Speed limit [m/s].
