@@ -1,7 +1,8 @@
 // Both image front ends end to end on a short synthetic sequence rendered
 // into images (`vio simulate --camera=images`, made in the test's temp dir),
 // then `vio run` with SWF(10): the run completes and the ATE stays small; the
-// KLT run is the default one for a dataset with images and no features0.
+// KLT run is the default one for a dataset with images and no features0; one
+// and two pipeline threads give the same bytes.
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -104,6 +105,32 @@ TEST_F(FrontendRendered, BagGivesTheFolderTrajectory) {
 }
 
 TEST_F(FrontendRendered, Brisk) { ExpectAteBelow("brisk", "--frontend=brisk", 0.1); }
+
+// The pipeline's second thread (reading, decoding and the pyramids ahead of
+// the tracking) changes nothing: trajectories and observations byte for byte
+// equal to the one-thread run, for both image front ends.
+TEST_F(FrontendRendered, PipelineThreadsGiveTheSameBytes) {
+  for (const std::string frontend : {"klt", "brisk"}) {
+    std::string files[2][2];
+    for (int threads = 1; threads <= 2; ++threads) {
+      const std::string out = dir_ + "/" + frontend + "_threads_" + std::to_string(threads);
+      ASSERT_EQ(RunVio("run --dataset=" + dir_ + "/data --output_dir=" + out + " --frontend=" + frontend +
+                           " --pipeline_threads=" + std::to_string(threads) +
+                           " --policy=msckf --window_size=10 --output_observations",
+                       out + ".log"),
+                0)
+          << "see " << out << ".log";
+      files[threads - 1][0] = ReadFile(out + "/trajectory.txt");
+      files[threads - 1][1] = ReadFile(out + "/observations.csv");
+      EXPECT_NE(ReadFile(out + "/summary.json").find("\"pipeline_threads\": " + std::to_string(threads)),
+                std::string::npos);
+    }
+    EXPECT_GT(files[0][0].size(), 10000u) << frontend;
+    EXPECT_GT(files[0][1].size(), 100000u) << frontend;
+    EXPECT_TRUE(files[0][0] == files[1][0]) << frontend << ": trajectories differ";
+    EXPECT_TRUE(files[0][1] == files[1][1]) << frontend << ": observations differ";
+  }
+}
 
 }  // namespace
 }  // namespace vio
