@@ -221,7 +221,8 @@ void KltFrontend::MatchTracks(const StereoImages& images) {
   MatchAt(images, retry);
 }
 
-std::optional<double> KltFrontend::SearchRow(const StereoImages& images, const cv::Point2f& uv0_px) const {
+std::optional<double> KltFrontend::SearchRow(const StereoImages& images, const cv::Point2f& uv0_px) {
+  CountRowSearch();
   const std::optional<Eigen::Vector2d> rect = rectifier().Rectify(0, Eigen::Vector2d(uv0_px.x, uv0_px.y));
   if (!rect) return std::nullopt;
   return row_search_.Disparity(images.left, images.right, *rect);

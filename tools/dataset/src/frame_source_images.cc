@@ -219,6 +219,7 @@ std::string ImageFrameSource::ReportJson() const {
      << ", \"stereo_row_difference_median_px\": " << Number(s.MedianRowDifferencePx())
      << ", \"temporal_matches\": " << s.temporal_matches << ", \"rejected_reprojection\": " << s.rejected_reprojection
      << ", \"new_tracks\": " << s.new_tracks << ", \"reidentified\": " << s.reidentified
+     << ", \"row_searches\": " << s.row_searches
      << ", \"track_length\": " << TrackLengthJson(frontend_->tracks())
      << ", \"stage_ms\": {\"load\": " << Number(load_ms_ / frames) << ", \"detect\": "
      << Number(s.time.detect_ms / frames) << ", \"stereo_match\": " << Number(s.time.stereo_ms / frames)

@@ -124,7 +124,7 @@ class KltFrontend final : public StereoFrontend {
   /// Stereo matches of the tracks: from the last disparity, then the row search.
   void MatchTracks(const StereoImages& images);
   /// The row search's disparity of a left pixel (nullopt: none found).
-  std::optional<double> SearchRow(const StereoImages& images, const cv::Point2f& uv0_px) const;
+  std::optional<double> SearchRow(const StereoImages& images, const cv::Point2f& uv0_px);
   /// LK left -> right for `tracks`, each seeded at its disparity_px; sets the
   /// match of those passing the checks.
   void MatchAt(const StereoImages& images, const std::vector<Track*>& tracks);

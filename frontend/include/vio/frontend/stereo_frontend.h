@@ -86,6 +86,7 @@ struct FrontendStats {
   std::int64_t rejected_reprojection = 0;   ///< of which rejected against the predicted pose
   std::int64_t new_tracks = 0;              ///< tracks started
   std::int64_t reidentified = 0;            ///< features given back the id of a landmark no recent frame matched
+  std::int64_t row_searches = 0;            ///< KLT: stereo row searches (new corners, retried tracks)
   StageTimes time;                          ///< summed over frames [ms]
   /// |v_L - v_R| of the stereo inliers in 0.01 px bins.
   std::vector<std::int64_t> row_difference_histogram;
@@ -145,6 +146,7 @@ class StereoFrontend {
   LandmarkId NewTrack();
   /// Counts features re-identified with a lost landmark (after RejectOutliers).
   void CountReidentified(std::int64_t count) { stats_.reidentified += count; }
+  void CountRowSearch() { ++stats_.row_searches; }
   /// The landmark's position: the window's estimate, else the track's own
   /// stereo triangulation; nullopt when neither exists.
   std::optional<Eigen::Vector3d> LandmarkPosition(LandmarkId id, const FramePrior& prior) const;
