@@ -128,8 +128,8 @@ class ImageFrameSource final : public FrameSource {
     if (unpaired_ > 0) LOG(WARNING) << mav0_ << ": " << unpaired_ << " cam0 frames have no cam1 image; skipped";
   }
 
-  // The pipeline's first stage for pair slot->k: read, decode (into the
-  // slot's images, reusing their memory), prepare. With two threads it runs
+  // The pipeline's first stage for pair slot->k: read, decode, prepare (into
+  // the slot's pair, reusing the memory of its pyramids). With two threads it runs
   // on the reader thread and finds the whole image's corners there.
   void MakePair(PipelinePair* slot) {
     frontend::PreparedPair* prepared = slot->pair.get();
@@ -158,9 +158,10 @@ class ImageFrameSource final : public FrameSource {
     const std::streamsize length = file ? static_cast<std::streamsize>(file.tellg()) : -1;
     bytes.resize(static_cast<size_t>(std::max<std::streamsize>(length, 0)));
     if (length > 0) file.seekg(0).read(reinterpret_cast<char*>(bytes.data()), length);
-    if (length <= 0 || !file || cv::imdecode(bytes, cv::IMREAD_GRAYSCALE, image).empty()) {
-      throw std::runtime_error(path + ": cannot read the image");
-    }
+    // A fresh image each time: imdecode into an existing one leaves it as it
+    // was when the bytes are no image.
+    *image = length > 0 && file ? cv::imdecode(bytes, cv::IMREAD_GRAYSCALE) : cv::Mat();
+    if (image->empty()) throw std::runtime_error(path + ": cannot read the image");
   }
 
   void WriteDebugImage(Timestamp t_ns, const cv::Mat& left, const cv::Mat& right) {
