@@ -10,8 +10,6 @@
 
 #include <time.h>
 
-#include <fstream>
-
 #include <glog/logging.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -153,14 +151,7 @@ class ImageFrameSource final : public FrameSource {
       return;
     }
     const std::string path = mav0_ + "/cam" + std::to_string(camera) + "/data/" + filenames_[camera][row];
-    std::vector<uchar>& bytes = file_bytes_[camera];
-    std::ifstream file(path, std::ios::binary | std::ios::ate);
-    const std::streamsize length = file ? static_cast<std::streamsize>(file.tellg()) : -1;
-    bytes.resize(static_cast<size_t>(std::max<std::streamsize>(length, 0)));
-    if (length > 0) file.seekg(0).read(reinterpret_cast<char*>(bytes.data()), length);
-    // A fresh image each time: imdecode into an existing one leaves it as it
-    // was when the bytes are no image.
-    *image = length > 0 && file ? cv::imdecode(bytes, cv::IMREAD_GRAYSCALE) : cv::Mat();
+    *image = cv::imread(path, cv::IMREAD_GRAYSCALE);
     if (image->empty()) throw std::runtime_error(path + ": cannot read the image");
   }
 
@@ -186,7 +177,6 @@ class ImageFrameSource final : public FrameSource {
   double prepare_wall_ms_ = 0;  ///< Prepare, wall time on the thread that did it
   double frontend_cpu_ms_ = 0;  ///< the front end's tracking, CPU time of its thread
   int threads_;                 ///< of the pipeline: 1 or 2
-  std::vector<uchar> file_bytes_[2];  ///< an image file's bytes, per camera (reused)
   std::optional<PairPipeline> pipeline_;  ///< declared last: its reader thread stops first
 };
 
