@@ -43,7 +43,7 @@ for arg in "$@"; do
     --cache=*) cache="${arg#--cache=}" ;;
     --rendered_s=*) rendered_s="${arg#--rendered_s=}" ;;
     --repeat=*) repeat="${arg#--repeat=}" ;;
-    -h|--help) sed -n '2,28p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
     *) echo "bench.sh: unknown argument '$arg' (see --help)" >&2; exit 2 ;;
   esac
 done
