@@ -25,8 +25,9 @@ BriskFrontend::BriskFrontend(const FrontendOptions& options, const StereoRectifi
       brisk_(cv::BRISK::create(options.brisk_threshold, options.brisk_octaves)),
       grid_(rectifier.camera_model(0).width(), rectifier.camera_model(0).height(), options.grid_cell_px) {}
 
-std::vector<FrameFeature> BriskFrontend::TrackFrame(const cv::Mat& left, const cv::Mat& right,
-                                                    const FramePrior& prior) {
+std::vector<FrameFeature> BriskFrontend::TrackFrame(PreparedPair* pair, const FramePrior& prior) {
+  const cv::Mat& left = pair->left;
+  const cv::Mat& right = pair->right;
   std::int64_t start = NowNs();
   // The right image keeps more per cell: its cells hold other scene parts
   // (disparity) than the left image's.

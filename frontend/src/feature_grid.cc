@@ -7,7 +7,8 @@
 
 namespace vio::frontend {
 
-FeatureGrid::FeatureGrid(int width_px, int height_px, double cell_px) : cell_px_(cell_px) {
+FeatureGrid::FeatureGrid(int width_px, int height_px, double cell_px)
+    : cell_px_(cell_px), width_px_(width_px), height_px_(height_px) {
   if (width_px <= 0 || height_px <= 0 || !(cell_px > 0)) {
     throw std::invalid_argument("FeatureGrid: image size and cell size must be positive");
   }
@@ -19,6 +20,16 @@ int FeatureGrid::Cell(const cv::Point2f& uv_px) const {
   const int col = std::clamp(static_cast<int>(std::floor(uv_px.x / cell_px_)), 0, cols_ - 1);
   const int row = std::clamp(static_cast<int>(std::floor(uv_px.y / cell_px_)), 0, rows_ - 1);
   return row * cols_ + col;
+}
+
+// Pixel x is in column floor(x / cell_px): columns col * cell_px <= x <
+// (col + 1) * cell_px, the last one reaching the image's edge (Cell clamps).
+cv::Rect FeatureGrid::CellRect(int cell) const {
+  const int col = cell % cols_, row = cell / cols_;
+  auto first = [&](int k) { return static_cast<int>(std::ceil(k * cell_px_)); };
+  const int x1 = col + 1 == cols_ ? width_px_ : std::min(first(col + 1), width_px_);
+  const int y1 = row + 1 == rows_ ? height_px_ : std::min(first(row + 1), height_px_);
+  return cv::Rect(cv::Point(first(col), first(row)), cv::Point(x1, y1));
 }
 
 std::vector<int> FeatureGrid::Bucket(const std::vector<cv::KeyPoint>& keypoints, int per_cell) const {

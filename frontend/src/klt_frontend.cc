@@ -60,33 +60,44 @@ KltFrontend::KltFrontend(const FrontendOptions& options, const StereoRectifier& 
       grid_(rectifier.camera_model(0).width(), rectifier.camera_model(0).height(), options.grid_cell_px),
       row_search_(rectifier, kRowSearchPatchPx, options.klt_max_disparity_px, options.klt_min_ncc) {}
 
-std::vector<FrameFeature> KltFrontend::TrackFrame(const cv::Mat& left, const cv::Mat& right,
-                                                  const FramePrior& prior) {
+// The pyramids (the left one over klt_pyramid_levels for the temporal LK,
+// the right one at full resolution for the stereo LK) are built once here
+// and serve every LK of the frame; the left one is the next frame's
+// previous pyramid.
+void KltFrontend::PrepareImages(bool with_corners, PreparedPair* pair) const {
+  const cv::Size window(options().klt_window_px, options().klt_window_px);
+  cv::buildOpticalFlowPyramid(pair->left, pair->left_pyramid, window, options().klt_pyramid_levels);
+  cv::buildOpticalFlowPyramid(pair->right, pair->right_pyramid, window, kStereoPyramidLevels);
+  if (with_corners) {
+    cv::FAST(pair->left, pair->corners, options().klt_fast_threshold, /*nonmaxSuppression=*/true);
+    pair->corners_ready = true;
+  }
+}
+
+std::vector<FrameFeature> KltFrontend::TrackFrame(PreparedPair* pair, const FramePrior& prior) {
   std::int64_t start = NowNs();
-  const std::vector<cv::Mat> left_pyramid = Pyramid(left, options().klt_pyramid_levels);
-  TrackTemporal(left_pyramid, prior);
+  TrackTemporal(pair->left_pyramid, prior);
   AddTime(&StageTimes::temporal_ms, start);
   start = NowNs();
-  const std::vector<cv::Mat> right_pyramid = Pyramid(right, kStereoPyramidLevels);
-  const StereoImages images{left, right, left_pyramid, right_pyramid};
+  const StereoImages images{pair->left, pair->right, pair->left_pyramid, pair->right_pyramid};
   MatchTracks(images);
   AddTime(&StageTimes::stereo_ms, start);
   start = NowNs();
-  std::vector<int> per_cell;
-  cv::Mat mask = Thin(left, &per_cell);
+  Thin(pair->left);
   AddTime(&StageTimes::detect_ms, start);
   start = NowNs();
-  const std::set<LandmarkId> reidentified = Reidentify(images, prior, &mask, &per_cell);
+  const std::set<LandmarkId> reidentified = Reidentify(images, prior, &mask_, &per_cell_);
   AddTime(&StageTimes::temporal_ms, start);
   start = NowNs();
-  DetectNew(images, &mask, &per_cell);
+  DetectNew(images, *pair);
   AddTime(&StageTimes::detect_ms, start);
   std::vector<FrameFeature> features = Features();
   DropTracks(RejectOutliers(prior, &features));
   CountReidentified(std::count_if(features.begin(), features.end(),
                                   [&](const FrameFeature& f) { return reidentified.count(f.id) > 0; }));
   Remember(prior);
-  previous_left_ = left_pyramid;
+  // The pair takes the buffers of the pyramid before: Prepare refills them.
+  std::swap(previous_left_, pair->left_pyramid);
   return features;
 }
 
@@ -96,13 +107,6 @@ void KltFrontend::DropTracks(const std::vector<LandmarkId>& rejected) {
   tracks_.erase(std::remove_if(tracks_.begin(), tracks_.end(),
                                [&](const Track& t) { return dropped.count(t.id.value) > 0; }),
                 tracks_.end());
-}
-
-std::vector<cv::Mat> KltFrontend::Pyramid(const cv::Mat& image, int levels) const {
-  std::vector<cv::Mat> pyramid;
-  const int side = options().klt_window_px;
-  cv::buildOpticalFlowPyramid(image, pyramid, cv::Size(side, side), levels);
-  return pyramid;
 }
 
 std::vector<bool> KltFrontend::TrackPoints(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
@@ -213,7 +217,8 @@ void KltFrontend::MatchTracks(const StereoImages& images) {
   MatchAt(images, retry);
 }
 
-std::optional<double> KltFrontend::SearchRow(const StereoImages& images, const cv::Point2f& uv0_px) const {
+std::optional<double> KltFrontend::SearchRow(const StereoImages& images, const cv::Point2f& uv0_px) {
+  CountRowSearch();
   const std::optional<Eigen::Vector2d> rect = rectifier().Rectify(0, Eigen::Vector2d(uv0_px.x, uv0_px.y));
   if (!rect) return std::nullopt;
   return row_search_.Disparity(images.left, images.right, *rect);
@@ -247,15 +252,17 @@ cv::Point2f KltFrontend::RightPixelAt(const cv::Point2f& uv0_px, double disparit
   return uv1 ? cv::Point2f(static_cast<float>(uv1->x()), static_cast<float>(uv1->y())) : uv0_px;
 }
 
-cv::Mat KltFrontend::Thin(const cv::Mat& left, std::vector<int>* per_cell) {
+void KltFrontend::Thin(const cv::Mat& left) {
   for (Track& t : tracks_) t.frames_without_stereo = t.match ? 0 : t.frames_without_stereo + 1;
   std::stable_sort(tracks_.begin(), tracks_.end(), [](const Track& a, const Track& b) { return a.age > b.age; });
-  per_cell->assign(static_cast<size_t>(grid_.num_cells()), 0);
-  cv::Mat mask(left.size(), CV_8UC1, cv::Scalar(255));
+  per_cell_.assign(static_cast<size_t>(grid_.num_cells()), 0);
+  mask_.create(left.size(), CV_8UC1);
+  mask_.setTo(cv::Scalar(255));
+  cv::Mat& mask = mask_;
   const int radius = static_cast<int>(options().klt_min_distance_px);
   std::vector<Track> kept;
   for (const Track& t : tracks_) {
-    int& n = (*per_cell)[static_cast<size_t>(grid_.Cell(t.uv0_px))];
+    int& n = per_cell_[static_cast<size_t>(grid_.Cell(t.uv0_px))];
     const cv::Point pixel(cvRound(t.uv0_px.x), cvRound(t.uv0_px.y));
     if (t.frames_without_stereo > kMaxFramesWithoutStereo || n >= options().klt_per_cell ||
         mask.at<uchar>(pixel) == 0) {
@@ -266,13 +273,12 @@ cv::Mat KltFrontend::Thin(const cv::Mat& left, std::vector<int>* per_cell) {
     kept.push_back(t);
   }
   tracks_ = std::move(kept);
-  return mask;
 }
 
 // Candidates are stereo-matched at once; only the matched ones become
 // features (and get an id).
-void KltFrontend::DetectNew(const StereoImages& images, cv::Mat* mask, std::vector<int>* per_cell) {
-  std::vector<Track> candidates = Candidates(images, mask, per_cell);
+void KltFrontend::DetectNew(const StereoImages& images, const PreparedPair& pair) {
+  std::vector<Track> candidates = Candidates(images, pair);
   std::vector<Track*> pointers;
   for (Track& t : candidates) pointers.push_back(&t);
   MatchAt(images, pointers);
@@ -289,23 +295,20 @@ void KltFrontend::DetectNew(const StereoImages& images, cv::Mat* mask, std::vect
 // are missing); a corner must be klt_min_distance_px from every
 // feature and found by the row search (at most kSearchesPerWantedFeature
 // tries per wanted feature and cell).
-std::vector<KltFrontend::Track> KltFrontend::Candidates(const StereoImages& images, cv::Mat* mask,
-                                                        std::vector<int>* per_cell) const {
+std::vector<KltFrontend::Track> KltFrontend::Candidates(const StereoImages& images, const PreparedPair& pair) {
+  std::vector<int>& per_cell = per_cell_;
   const int per_cell_max = options().klt_per_cell;
   const int wanted = options().klt_max_features - static_cast<int>(tracks_.size());
   std::vector<Track> candidates;
-  const bool open = std::any_of(per_cell->begin(), per_cell->end(), [&](int n) { return n < per_cell_max; });
+  const bool open = std::any_of(per_cell.begin(), per_cell.end(), [&](int n) { return n < per_cell_max; });
   if (!open || wanted < kMinMissingFraction * options().klt_max_features) {
     return candidates;
   }
-  std::vector<cv::KeyPoint> corners;
-  cv::FAST(images.left, corners, options().klt_fast_threshold, /*nonmaxSuppression=*/true);
-  std::stable_sort(corners.begin(), corners.end(),
-                   [](const cv::KeyPoint& a, const cv::KeyPoint& b) { return a.response > b.response; });
-  std::vector<int> searches(per_cell->size(), 0);
-  std::vector<int> search_budget(per_cell->size());
-  for (size_t c = 0; c < per_cell->size(); ++c) {
-    search_budget[c] = kSearchesPerWantedFeature * std::max(0, per_cell_max - (*per_cell)[c]);
+  const std::vector<cv::KeyPoint>& corners = OpenCellCorners(pair);
+  std::vector<int> searches(per_cell.size(), 0);
+  std::vector<int> search_budget(per_cell.size());
+  for (size_t c = 0; c < per_cell.size(); ++c) {
+    search_budget[c] = kSearchesPerWantedFeature * std::max(0, per_cell_max - per_cell[c]);
   }
   const int radius = static_cast<int>(options().klt_min_distance_px);
   for (int round = 1; round <= per_cell_max; ++round) {
@@ -313,14 +316,14 @@ std::vector<KltFrontend::Track> KltFrontend::Candidates(const StereoImages& imag
       if (static_cast<int>(candidates.size()) >= wanted) return candidates;
       const auto cell = static_cast<size_t>(grid_.Cell(corner.pt));
       const cv::Point pixel(cvRound(corner.pt.x), cvRound(corner.pt.y));
-      if ((*per_cell)[cell] >= round || searches[cell] >= search_budget[cell] || mask->at<uchar>(pixel) == 0) {
+      if (per_cell[cell] >= round || searches[cell] >= search_budget[cell] || mask_.at<uchar>(pixel) == 0) {
         continue;
       }
       ++searches[cell];
       const std::optional<double> disparity = SearchRow(images, corner.pt);
       if (!disparity) continue;
-      ++(*per_cell)[cell];
-      cv::circle(*mask, pixel, radius, cv::Scalar(0), cv::FILLED);
+      ++per_cell[cell];
+      cv::circle(mask_, pixel, radius, cv::Scalar(0), cv::FILLED);
       Track t;
       t.uv0_px = corner.pt;
       t.disparity_px = *disparity;

@@ -74,10 +74,33 @@ StereoFrontend::StereoFrontend(const FrontendOptions& options, const StereoRecti
 
 StereoFrame StereoFrontend::Process(Timestamp t_ns, const cv::Mat& left, const cv::Mat& right,
                                     const FramePrior& prior) {
+  const std::int64_t start = NowNs();
+  Prepare(left, right, /*with_corners=*/false, &scratch_);
+  const double prepare_ms = 1e-6 * static_cast<double>(NowNs() - start);
+  StereoFrame frame = Process(t_ns, &scratch_, prior);
+  AddPrepareTime(prepare_ms);
+  return frame;
+}
+
+void StereoFrontend::AddPrepareTime(double ms) {
+  last_times_.prepare_ms += ms;
+  stats_.time.prepare_ms += ms;
+}
+
+void StereoFrontend::Prepare(const cv::Mat& left, const cv::Mat& right, bool with_corners,
+                             PreparedPair* pair) const {
   CheckImage(left, rectifier_.camera_model(0).calibration(), "left");
   CheckImage(right, rectifier_.camera_model(1).calibration(), "right");
+  pair->left = left;
+  pair->right = right;
+  pair->corners.clear();
+  pair->corners_ready = false;
+  PrepareImages(with_corners, pair);
+}
+
+StereoFrame StereoFrontend::Process(Timestamp t_ns, PreparedPair* pair, const FramePrior& prior) {
   last_times_ = StageTimes{};
-  features_ = TrackFrame(left, right, prior);
+  features_ = TrackFrame(pair, prior);
   StereoFrame frame = Emit(t_ns, prior);
   ++stats_.frames;
   stats_.observations_per_frame.push_back(static_cast<int>(frame.observations.size()));

@@ -1,8 +1,10 @@
 // Both image front ends end to end on a short synthetic sequence rendered
 // into images (`vio simulate --camera=images`, made in the test's temp dir),
 // then `vio run` with SWF(10): the run completes and the ATE stays small; the
-// KLT run is the default one for a dataset with images and no features0.
+// KLT run is the default one for a dataset with images and no features0; one
+// and two pipeline threads give the same bytes.
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -104,6 +106,72 @@ TEST_F(FrontendRendered, BagGivesTheFolderTrajectory) {
 }
 
 TEST_F(FrontendRendered, Brisk) { ExpectAteBelow("brisk", "--frontend=brisk", 0.1); }
+
+// The pipeline's second thread (reading, decoding and the pyramids ahead of
+// the tracking) changes nothing: trajectories and observations byte for byte
+// equal to the one-thread run, for both image front ends.
+TEST_F(FrontendRendered, PipelineThreadsGiveTheSameBytes) {
+  for (const std::string frontend : {"klt", "brisk"}) {
+    std::string files[2][2];
+    for (int threads = 1; threads <= 2; ++threads) {
+      const std::string out = dir_ + "/" + frontend + "_threads_" + std::to_string(threads);
+      ASSERT_EQ(RunVio("run --dataset=" + dir_ + "/data --output_dir=" + out + " --frontend=" + frontend +
+                           " --pipeline_threads=" + std::to_string(threads) +
+                           " --policy=msckf --window_size=10 --output_observations",
+                       out + ".log"),
+                0)
+          << "see " << out << ".log";
+      files[threads - 1][0] = ReadFile(out + "/trajectory.txt");
+      files[threads - 1][1] = ReadFile(out + "/observations.csv");
+      EXPECT_NE(ReadFile(out + "/summary.json").find("\"pipeline_threads\": " + std::to_string(threads)),
+                std::string::npos);
+    }
+    EXPECT_GT(files[0][0].size(), 10000u) << frontend;
+    EXPECT_GT(files[0][1].size(), 100000u) << frontend;
+    EXPECT_TRUE(files[0][0] == files[1][0]) << frontend << ": trajectories differ";
+    EXPECT_TRUE(files[0][1] == files[1][1]) << frontend << ": observations differ";
+  }
+}
+
+// An image that cannot be decoded mid-run stops the run with status failed,
+// naming the file, whichever thread decoded it; what was estimated before is
+// kept, the same for one and two pipeline threads. (The dataset links to the
+// rendered files; one image is replaced by a few bytes of text.)
+TEST_F(FrontendRendered, AnUnreadableImageStopsTheRunAlikeForOneAndTwoThreads) {
+  namespace fs = std::filesystem;
+  const fs::path from = fs::path(dir_) / "data", to = fs::path(dir_) / "broken";
+  fs::remove_all(to);
+  for (const fs::directory_entry& entry : fs::recursive_directory_iterator(from)) {
+    const fs::path target = to / fs::relative(entry.path(), from);
+    if (entry.is_directory()) {
+      fs::create_directories(target);
+    } else {
+      fs::create_symlink(entry.path(), target);
+    }
+  }
+  std::ifstream frames(from / "mav0/cam1/data.csv");
+  std::string line;
+  for (int row = 0; row <= 60 && std::getline(frames, line);) row += !line.empty() && line[0] != '#';
+  const std::string name = line.substr(line.find(',') + 1, line.find_first_of("\r\n", line.find(',')) - line.find(',') - 1);
+  const fs::path broken = to / "mav0/cam1/data" / name;
+  ASSERT_TRUE(fs::is_symlink(broken)) << broken;
+  fs::remove(broken);
+  std::ofstream(broken) << "not an image";
+  std::string trajectories[2];
+  for (int threads = 1; threads <= 2; ++threads) {
+    const std::string out = dir_ + "/broken_threads_" + std::to_string(threads);
+    EXPECT_NE(RunVio("run --dataset=" + to.string() + " --output_dir=" + out + " --frontend=klt --pipeline_threads=" +
+                         std::to_string(threads) + " --policy=msckf --window_size=10",
+                     out + ".log"),
+              0);
+    const std::string summary = ReadFile(out + "/summary.json");
+    EXPECT_NE(summary.find("\"status\": \"failed\""), std::string::npos) << summary;
+    EXPECT_NE(summary.find(name + ": cannot read the image"), std::string::npos) << summary;
+    trajectories[threads - 1] = ReadFile(out + "/trajectory.txt");
+  }
+  EXPECT_GT(trajectories[0].size(), 1000u);
+  EXPECT_TRUE(trajectories[0] == trajectories[1]);
+}
 
 }  // namespace
 }  // namespace vio

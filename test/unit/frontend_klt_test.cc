@@ -80,6 +80,10 @@ class DistortedPlaneTest : public ::testing::Test {
       : rectifier_(EurocCamera(0), EurocCamera(1)),
         texture_(RandomTexture(cv::Size(752 + 2 * kMarginPx + 300, 480 + 2 * kMarginPx), 11)) {}
 
+  /// Five frames moving right: the same frames with whole-image corners
+  /// prepared (as the read-ahead thread does) as with FAST on open cells only.
+  void ExpectSameFramesWithPreparedCorners(const FrontendOptions& options);
+
   StereoRectifier rectifier_;
   cv::Mat texture_;
 };
@@ -195,6 +199,42 @@ TEST_F(DistortedPlaneTest, KltTracksAJumpFromThePredictedPose) {
   // A fifth of the first frame leaves the image.
   EXPECT_GT(predicted, 0.6);
   EXPECT_LT(unpredicted, 0.2);
+}
+
+// A front end whose pairs were prepared with the whole image's FAST corners
+// (as the read-ahead thread does) emits the same frames as one that runs
+// FAST only in the grid cells that need features, over frames that lose
+// tracks at the border and refill them.
+// Default options (most cells open: FAST on the whole image), and one
+// feature per cell with a large budget (after the first frame few cells are
+// open: FAST on each grid row's span of open cells).
+TEST_F(DistortedPlaneTest, WholeImageCornersGiveTheSameFramesAsPerCellDetection) {
+  FrontendOptions options;
+  options.frontend = "klt";
+  ExpectSameFramesWithPreparedCorners(options);
+  options.klt_per_cell = 1;
+  options.klt_max_features = 1000;
+  ExpectSameFramesWithPreparedCorners(options);
+}
+
+void DistortedPlaneTest::ExpectSameFramesWithPreparedCorners(const FrontendOptions& options) {
+  const auto per_cell = MakeStereoFrontend(options, rectifier_);
+  const auto whole = MakeStereoFrontend(options, rectifier_);
+  PreparedPair prepared;
+  for (int k = 0; k < 5; ++k) {
+    const RawPair pair = MakePair(rectifier_, texture_, 30.0, 12.0 * k);
+    const StereoFrame expected = per_cell->Process(k, pair.left, pair.right, FramePrior{});
+    whole->Prepare(pair.left, pair.right, /*with_corners=*/true, &prepared);
+    ASSERT_TRUE(prepared.corners_ready);
+    const StereoFrame got = whole->Process(k, &prepared, FramePrior{});
+    ASSERT_EQ(got.observations.size(), expected.observations.size()) << "frame " << k;
+    ASSERT_GT(got.observations.size(), 80u);
+    for (size_t i = 0; i < got.observations.size(); ++i) {
+      EXPECT_EQ(got.observations[i].landmark, expected.observations[i].landmark);
+      EXPECT_EQ(got.observations[i].z_px, expected.observations[i].z_px);
+    }
+  }
+  EXPECT_GT(per_cell->stats().new_tracks, per_cell->stats().observations_per_frame.front());
 }
 
 TEST_F(DistortedPlaneTest, KltRejectsABadFeatureBudget) {

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <future>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -16,6 +15,7 @@
 
 #include "vio/frontend/stereo_frontend.h"
 #include "vio/frontend/track_drawing.h"
+#include "pair_pipeline.h"
 #include "vio/dataset/rosbag_dataset.h"
 
 namespace vio::tools {
@@ -46,6 +46,16 @@ double ThreadCpuMs() {
   return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
 }
 
+// The pipeline's threads for the option's value: 0 picks 2 when this process
+// may run on two processors or more, else 1 (a second thread would only take
+// the tracking's core).
+int PipelineThreads(int option) {
+  if (option != 0) return option;
+  const int threads = AvailableCpus() >= 2 ? 2 : 1;
+  LOG(INFO) << "pipeline_threads=0: " << threads << " (" << AvailableCpus() << " processors available)";
+  return threads;
+}
+
 class ImageFrameSource final : public FrameSource {
  public:
   ImageFrameSource(const FrontendOptions& options, const EurocDataset& dataset,
@@ -53,7 +63,8 @@ class ImageFrameSource final : public FrameSource {
       : name_(options.frontend),
         mav0_(dataset.root + "/mav0"),
         debug_dir_(options.debug_images),
-        frontend_(frontend::MakeStereoFrontend(options, rectifier)) {
+        frontend_(frontend::MakeStereoFrontend(options, rectifier)),
+        threads_(PipelineThreads(options.pipeline_threads)) {
     for (int i = 0; i < 2; ++i) {
       filenames_[i].reserve(dataset.frames[i].size());
       for (const CameraFrame& f : dataset.frames[i]) filenames_[i].push_back(f.filename);
@@ -61,23 +72,35 @@ class ImageFrameSource final : public FrameSource {
     }
     PairFrames(dataset);
     if (!debug_dir_.empty()) std::filesystem::create_directories(debug_dir_);
+    pipeline_.emplace(pairs_.size(), threads_, [this](PipelinePair* slot) { MakePair(slot); });
   }
 
   size_t size() const override { return pairs_.size(); }
   Timestamp time(size_t k) const override { return pairs_[k].t_ns; }
 
+  // Pair k from the pipeline's first stage, tracked with the estimator's
+  // prediction (the second stage, on this thread).
   StereoFrame Frame(size_t k, const Estimator& estimator) override {
     const Pair& pair = pairs_[k];
     const auto start = std::chrono::steady_clock::now();
-    const auto [left, right] = TakeImages(k);
-    load_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    PipelinePair slot = pipeline_->Take(k);
+    // One thread: Take prepared the pair, which is the front end's time;
+    // two: the waiting for the reader thread is all Take cost here.
+    const double prepare_here_ms = threads_ == 1 ? slot.prepare_wall_ms : 0.0;
+    load_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() -
+                prepare_here_ms;
+    decode_cpu_ms_ += slot.decode_cpu_ms;
+    prepare_cpu_ms_ += slot.prepare_cpu_ms;
+    prepare_wall_ms_ += slot.prepare_wall_ms;
     frontend::FramePrior prior;
     prior.T_w_b = estimator.PredictBodyPose(pair.t_ns);
     prior.landmarks = &estimator.window().landmarks();
     const double cpu_start_ms = ThreadCpuMs();
-    StereoFrame frame = frontend_->Process(pair.t_ns, left, right, prior);
+    StereoFrame frame = frontend_->Process(pair.t_ns, slot.pair.get(), prior);
+    frontend_->AddPrepareTime(prepare_here_ms);
     frontend_cpu_ms_ += ThreadCpuMs() - cpu_start_ms;
-    if (!debug_dir_.empty()) WriteDebugImage(pair.t_ns, left, right);
+    if (!debug_dir_.empty()) WriteDebugImage(pair.t_ns, slot.pair->left, slot.pair->right);
+    pipeline_->Give(std::move(slot));
     return frame;
   }
 
@@ -103,37 +126,33 @@ class ImageFrameSource final : public FrameSource {
     if (unpaired_ > 0) LOG(WARNING) << mav0_ << ": " << unpaired_ << " cam0 frames have no cam1 image; skipped";
   }
 
-  struct LoadedPair {
-    cv::Mat left, right;
-    double cpu_ms = 0;  ///< CPU time the reading and decoding took on its thread
-  };
-
-  // Pair k, decoded by the read-ahead started for it (else now); starts the
-  // read-ahead of pair k + 1 on another thread, so decoding overlaps tracking.
-  std::pair<cv::Mat, cv::Mat> TakeImages(size_t k) {
-    LoadedPair images = next_.valid() && next_k_ == k ? next_.get() : LoadPair(k);
-    decode_cpu_ms_ += images.cpu_ms;
-    if (k + 1 < pairs_.size()) {
-      next_k_ = k + 1;
-      next_ = std::async(std::launch::async, [this, k] { return LoadPair(k + 1); });
-    }
-    return {images.left, images.right};
-  }
-
-  LoadedPair LoadPair(size_t k) {
-    const double start_ms = ThreadCpuMs();
-    LoadedPair images{Load(0, pairs_[k].left), Load(1, pairs_[k].right)};
-    images.cpu_ms = ThreadCpuMs() - start_ms;
-    return images;
+  // The pipeline's first stage for pair slot->k: read, decode, prepare (into
+  // the slot's pair, reusing the memory of its pyramids). With two threads it runs
+  // on the reader thread and finds the whole image's corners there.
+  void MakePair(PipelinePair* slot) {
+    frontend::PreparedPair* prepared = slot->pair.get();
+    double start_ms = ThreadCpuMs();
+    Load(0, pairs_[slot->k].left, &prepared->left);
+    Load(1, pairs_[slot->k].right, &prepared->right);
+    slot->decode_cpu_ms = ThreadCpuMs() - start_ms;
+    const auto wall_start = std::chrono::steady_clock::now();
+    start_ms = ThreadCpuMs();
+    const cv::Mat left = prepared->left, right = prepared->right;
+    frontend_->Prepare(left, right, /*with_corners=*/threads_ == 2, prepared);
+    slot->prepare_cpu_ms = ThreadCpuMs() - start_ms;
+    slot->prepare_wall_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall_start).count();
   }
 
   // The image of one data.csv row: a file under camN/data/, or a bag message.
-  cv::Mat Load(int camera, size_t row) {
-    if (bag_readers_[camera]) return bag_readers_[camera]->Read(row);
+  void Load(int camera, size_t row, cv::Mat* image) {
+    if (bag_readers_[camera]) {
+      *image = bag_readers_[camera]->Read(row);
+      return;
+    }
     const std::string path = mav0_ + "/cam" + std::to_string(camera) + "/data/" + filenames_[camera][row];
-    cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
-    if (image.empty()) throw std::runtime_error(path + ": cannot read the image");
-    return image;
+    *image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    if (image->empty()) throw std::runtime_error(path + ": cannot read the image");
   }
 
   void WriteDebugImage(Timestamp t_ns, const cv::Mat& left, const cv::Mat& right) {
@@ -154,9 +173,11 @@ class ImageFrameSource final : public FrameSource {
   int unpaired_ = 0;
   double load_ms_ = 0;          ///< waiting for images (wall clock)
   double decode_cpu_ms_ = 0;    ///< reading and decoding, CPU time of the thread that did it
-  double frontend_cpu_ms_ = 0;  ///< the front end, CPU time of its thread
-  std::future<LoadedPair> next_;  ///< read-ahead (declared last: joined first)
-  size_t next_k_ = 0;
+  double prepare_cpu_ms_ = 0;   ///< Prepare (pyramids, corners), CPU time of the thread that did it
+  double prepare_wall_ms_ = 0;  ///< Prepare, wall time on the thread that did it
+  double frontend_cpu_ms_ = 0;  ///< the front end's tracking, CPU time of its thread
+  int threads_;                 ///< of the pipeline: 1 or 2
+  std::optional<PairPipeline> pipeline_;  ///< declared last: its reader thread stops first
 };
 
 std::string TrackLengthJson(const frontend::FeatureTracks& tracks) {
@@ -189,13 +210,17 @@ std::string ImageFrameSource::ReportJson() const {
      << ", \"stereo_row_difference_median_px\": " << Number(s.MedianRowDifferencePx())
      << ", \"temporal_matches\": " << s.temporal_matches << ", \"rejected_reprojection\": " << s.rejected_reprojection
      << ", \"new_tracks\": " << s.new_tracks << ", \"reidentified\": " << s.reidentified
+     << ", \"row_searches\": " << s.row_searches
      << ", \"track_length\": " << TrackLengthJson(frontend_->tracks())
      << ", \"stage_ms\": {\"load\": " << Number(load_ms_ / frames) << ", \"detect\": "
      << Number(s.time.detect_ms / frames) << ", \"stereo_match\": " << Number(s.time.stereo_ms / frames)
      << ", \"temporal_match\": " << Number(s.time.temporal_ms / frames) << ", \"reject\": "
-     << Number(s.time.reject_ms / frames) << ", \"frontend\": " << Number(s.time.total() / frames) << "}"
+     << Number(s.time.reject_ms / frames) << ", \"prepare\": " << Number(prepare_wall_ms_ / frames)
+     << ", \"frontend\": " << Number(s.time.total() / frames) << "}"
      << ", \"cpu_ms\": {\"decode\": " << Number(decode_cpu_ms_ / frames)
-     << ", \"frontend\": " << Number(frontend_cpu_ms_ / frames) << "}}";
+     << ", \"prepare\": " << Number(prepare_cpu_ms_ / frames)
+     << ", \"frontend\": " << Number((frontend_cpu_ms_ + prepare_cpu_ms_) / frames) << "}"
+     << ", \"pipeline_threads\": " << threads_ << "}";
   return os.str();
 }
 

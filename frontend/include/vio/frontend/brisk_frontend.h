@@ -49,7 +49,7 @@ class BriskFrontend final : public StereoFrontend {
   BriskFrontend(const FrontendOptions& options, const StereoRectifier& rectifier);
 
  protected:
-  std::vector<FrameFeature> TrackFrame(const cv::Mat& left, const cv::Mat& right, const FramePrior& prior) override;
+  std::vector<FrameFeature> TrackFrame(PreparedPair* pair, const FramePrior& prior) override;
 
  private:
   struct Detections {

@@ -17,6 +17,8 @@ class FeatureGrid {
   int num_cells() const { return cols_ * rows_; }
   int cols() const { return cols_; }
   int rows() const { return rows_; }
+  /// The image pixels (integer positions, inside the image) whose Cell() is `cell`.
+  cv::Rect CellRect(int cell) const;
 
   /// Indices of the keypoints kept when each cell keeps its `per_cell`
   /// strongest (largest response), ordered by decreasing response.
@@ -24,6 +26,7 @@ class FeatureGrid {
 
  private:
   double cell_px_;
+  int width_px_, height_px_;
   int cols_, rows_;
 };
 

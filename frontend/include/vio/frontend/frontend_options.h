@@ -56,6 +56,10 @@ struct FrontendOptions {
   double klt_min_ncc = 0.8;
   /// Folder receiving one PNG per frame with the tracks drawn; empty = none.
   std::string debug_images;
+  /// Image runs: threads of the pipeline; 1: everything on one thread; 2:
+  /// reading, decoding and the pyramids on a second one; 0: 2 when the
+  /// process may use two processors, else 1. Results do not depend on it.
+  int pipeline_threads = 0;
 
   template <class V>
   void Visit(V& v) {
@@ -89,6 +93,11 @@ struct FrontendOptions {
     v("klt_max_disparity_px", klt_max_disparity_px, "KLT largest disparity the stereo row search tries [px]", Positive());
     v("klt_min_ncc", klt_min_ncc, "KLT smallest ZNCC score of a stereo row-search match [-1, 1]", Between(-1, 1));
     v("debug_images", debug_images, "folder for one PNG per frame with the tracks drawn; empty = none");
+    v("pipeline_threads", pipeline_threads,
+      "image front ends: threads of the pipeline; 1 = all on one thread, 2 = image reading, decoding and "
+      "pyramids on a second thread, 0 = 2 when the process may use two processors, else 1; the results are "
+      "the same for every value [count]",
+      Between(0, 2));
   }
 };
 

@@ -3,7 +3,9 @@
 //   temporal  the left image's features are tracked from the previous left
 //             image (calcOpticalFlowPyrLK) and kept only when tracking back
 //             lands within klt_max_fb_px of the start (forward-backward
-//             check); a track whose landmark has a position starts at its
+//             check; both pyramids are built once per frame, in Prepare,
+//             and the left one serves the next frame); a track whose
+//             landmark has a position starts at its
 //             projection into the IMU-predicted camera and uses two pyramid
 //             levels, the others (and those that fail) start where they were
 //             and use klt_pyramid_levels;
@@ -20,7 +22,9 @@
 //             FAST corners (at least klt_min_distance_px from every feature)
 //             fill the cells in rounds (every open cell gets its first new
 //             corner, strongest first, before any gets a second) up to
-//             klt_per_cell per cell and klt_max_features in all; a corner
+//             klt_per_cell per cell and klt_max_features in all (FAST runs
+//             only on the cells below klt_per_cell, or its corners of the
+//             whole image come prepared: the same corners); a corner
 //             becomes a feature only when the row search finds it in the
 //             right image and the stereo LK from there passes both checks,
 //             so every new feature is a stereo observation at once;
@@ -69,7 +73,9 @@ class KltFrontend final : public StereoFrontend {
   KltFrontend(const FrontendOptions& options, const StereoRectifier& rectifier);
 
  protected:
-  std::vector<FrameFeature> TrackFrame(const cv::Mat& left, const cv::Mat& right, const FramePrior& prior) override;
+  std::vector<FrameFeature> TrackFrame(PreparedPair* pair, const FramePrior& prior) override;
+  /// The pyramids, and with `with_corners` the left image's FAST corners.
+  void PrepareImages(bool with_corners, PreparedPair* pair) const override;
 
  private:
   /// A left-right match that passed the forward-backward and epipolar checks.
@@ -94,7 +100,6 @@ class KltFrontend final : public StereoFrontend {
     const std::vector<cv::Mat>& right_pyramid;
   };
 
-  std::vector<cv::Mat> Pyramid(const cv::Mat& image, int levels) const;
   /// Forward-backward LK from `from` to `to`; `guess` is the initial position
   /// in `to` (updated to the result). Returns per point whether it is kept.
   std::vector<bool> TrackPoints(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
@@ -119,7 +124,7 @@ class KltFrontend final : public StereoFrontend {
   /// Stereo matches of the tracks: from the last disparity, then the row search.
   void MatchTracks(const StereoImages& images);
   /// The row search's disparity of a left pixel (nullopt: none found).
-  std::optional<double> SearchRow(const StereoImages& images, const cv::Point2f& uv0_px) const;
+  std::optional<double> SearchRow(const StereoImages& images, const cv::Point2f& uv0_px);
   /// LK left -> right for `tracks`, each seeded at its disparity_px; sets the
   /// match of those passing the checks.
   void MatchAt(const StereoImages& images, const std::vector<Track*>& tracks);
@@ -127,11 +132,11 @@ class KltFrontend final : public StereoFrontend {
   cv::Point2f RightPixelAt(const cv::Point2f& uv0_px, double disparity_px) const;
   /// Drops features without a stereo match for too long, the younger of two
   /// features closer than klt_min_distance_px and the youngest of a cell's
-  /// features beyond klt_per_cell; returns the mask of where new corners may
-  /// go and the count per cell.
-  cv::Mat Thin(const cv::Mat& left, std::vector<int>* per_cell);
-  /// New features from FAST corners where `mask` (from Thin) allows them.
-  void DetectNew(const StereoImages& images, cv::Mat* mask, std::vector<int>* per_cell);
+  /// features beyond klt_per_cell; sets mask_ (where new corners may go) and
+  /// per_cell_ (the count per cell).
+  void Thin(const cv::Mat& left);
+  /// New features from FAST corners where mask_ (from Thin) allows them.
+  void DetectNew(const StereoImages& images, const PreparedPair& pair);
   /// Lost landmarks found again (see above) become tracks where `mask`
   /// allows them; returns their ids.
   std::set<LandmarkId> Reidentify(const StereoImages& images, const FramePrior& prior, cv::Mat* mask,
@@ -151,13 +156,22 @@ class KltFrontend final : public StereoFrontend {
   void Remember(const FramePrior& prior);
   /// New-feature candidates: the strongest corners, spread over the cells in
   /// rounds, that the row search finds in the right image.
-  std::vector<Track> Candidates(const StereoImages& images, cv::Mat* mask, std::vector<int>* per_cell) const;
+  std::vector<Track> Candidates(const StereoImages& images, const PreparedPair& pair);
+  /// The FAST corners of the cells below klt_per_cell (per_cell_), sorted
+  /// strongest first; held in corners_.
+  const std::vector<cv::KeyPoint>& OpenCellCorners(const PreparedPair& pair);
   std::vector<FrameFeature> Features();
 
   FeatureGrid grid_;
   StereoRowSearch row_search_;
   std::vector<cv::Mat> previous_left_;  ///< pyramid of the previous left image
   std::vector<Track> tracks_;           ///< features of the left image
+  /// Per-frame buffers, kept to reuse their memory: where new corners may go
+  /// (Thin), features per grid cell, the corners of the open cells and of
+  /// one cell.
+  cv::Mat mask_;
+  std::vector<int> per_cell_;
+  std::vector<cv::KeyPoint> corners_, cell_corners_;
   /// Where a track was in the previous left image.
   struct Seen {
     LandmarkId id;

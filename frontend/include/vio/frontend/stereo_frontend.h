@@ -50,13 +50,30 @@ struct FrameFeature {
   bool tracked = false;  ///< continues a track of an earlier frame
 };
 
+/// A stereo pair and what a front end derives from the images alone (no
+/// estimator state): filled by StereoFrontend::Prepare, which may run on
+/// another thread than Process. Reused from pair to pair, so its buffers are
+/// allocated once.
+struct PreparedPair {
+  cv::Mat left, right;  ///< CV_8UC1, the calibrated size
+  /// KLT: the LK pyramids (with derivatives) of the left image over
+  /// klt_pyramid_levels and of the right image at full resolution.
+  std::vector<cv::Mat> left_pyramid, right_pyramid;
+  /// KLT: the FAST corners of the whole left image (nonmax-suppressed), when
+  /// Prepare was asked for them (corners_ready); else the tracker finds them
+  /// only in the grid cells that need new features.
+  std::vector<cv::KeyPoint> corners;
+  bool corners_ready = false;
+};
+
 /// Wall time of the front-end stages [ms].
 struct StageTimes {
   double detect_ms = 0;
   double stereo_ms = 0;
   double temporal_ms = 0;
   double reject_ms = 0;
-  double total() const { return detect_ms + stereo_ms + temporal_ms + reject_ms; }
+  double prepare_ms = 0;  ///< Prepare (KLT: the pyramids), wherever it ran
+  double total() const { return detect_ms + stereo_ms + temporal_ms + reject_ms + prepare_ms; }
 };
 
 /// Counts over all processed frames.
@@ -69,6 +86,7 @@ struct FrontendStats {
   std::int64_t rejected_reprojection = 0;   ///< of which rejected against the predicted pose
   std::int64_t new_tracks = 0;              ///< tracks started
   std::int64_t reidentified = 0;            ///< features given back the id of a landmark no recent frame matched
+  std::int64_t row_searches = 0;            ///< KLT: stereo row searches (new corners, retried tracks)
   StageTimes time;                          ///< summed over frames [ms]
   /// |v_L - v_R| of the stereo inliers in 0.01 px bins.
   std::vector<std::int64_t> row_difference_histogram;
@@ -87,11 +105,22 @@ class StereoFrontend {
 
   /// One stereo pair (CV_8UC1, the calibrated size; else std::invalid_argument).
   StereoFrame Process(Timestamp t_ns, const cv::Mat& left, const cv::Mat& right, const FramePrior& prior);
+  /// Fills `pair` from a stereo pair (throws like Process for bad images):
+  /// the work that needs no estimator state (KLT: the pyramids; with
+  /// `with_corners` also the left image's FAST corners). Reads only the
+  /// options: safe on another thread while Process runs on an earlier pair.
+  void Prepare(const cv::Mat& left, const cv::Mat& right, bool with_corners, PreparedPair* pair) const;
+  /// Process on a prepared pair; the same result as on its images. The
+  /// front end may swap buffers it keeps (the previous pyramid) into `pair`.
+  StereoFrame Process(Timestamp t_ns, PreparedPair* pair, const FramePrior& prior);
 
   /// The features of the last processed frame.
   const std::vector<FrameFeature>& features() const { return features_; }
   const FeatureTracks& tracks() const { return tracks_; }
   const FrontendStats& stats() const { return stats_; }
+  /// Counts the wall time of a Prepare run elsewhere (another thread) for
+  /// the last processed frame [ms].
+  void AddPrepareTime(double ms);
   /// Stage times of the last frame [ms].
   const StageTimes& last_times() const { return last_times_; }
   const StereoRectifier& rectifier() const { return rectifier_; }
@@ -99,8 +128,10 @@ class StereoFrontend {
 
  protected:
   /// Detects and matches in one stereo pair; returns the frame's features.
-  virtual std::vector<FrameFeature> TrackFrame(const cv::Mat& left, const cv::Mat& right,
-                                               const FramePrior& prior) = 0;
+  virtual std::vector<FrameFeature> TrackFrame(PreparedPair* pair, const FramePrior& prior) = 0;
+  /// The implementation's share of Prepare (after the images are checked and
+  /// stored in `pair`); none by default.
+  virtual void PrepareImages(bool /*with_corners*/, PreparedPair* /*pair*/) const {}
 
   /// The rectified measurement of a left-right pair; nullopt (and not an
   /// inlier) when a pixel cannot be rectified, the rows differ by more than
@@ -115,6 +146,7 @@ class StereoFrontend {
   LandmarkId NewTrack();
   /// Counts features re-identified with a lost landmark (after RejectOutliers).
   void CountReidentified(std::int64_t count) { stats_.reidentified += count; }
+  void CountRowSearch() { ++stats_.row_searches; }
   /// The landmark's position: the window's estimate, else the track's own
   /// stereo triangulation; nullopt when neither exists.
   std::optional<Eigen::Vector3d> LandmarkPosition(LandmarkId id, const FramePrior& prior) const;
@@ -131,6 +163,7 @@ class StereoFrontend {
   FrontendStats stats_;
   StageTimes last_times_;
   std::vector<FrameFeature> features_;
+  PreparedPair scratch_;  ///< Process on plain images prepares into it
 };
 
 /// The front end `options.frontend` names ("brisk" or "klt"). Throws std::invalid_argument for another name.
