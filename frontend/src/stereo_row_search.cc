@@ -79,69 +79,7 @@ std::vector<float> ZnccAlongStrip(const cv::Mat& strip, const cv::Mat& templ) {
   return scores;
 }
 
-/// OpenCV's fixed-point bilinear weights: INTER_TAB_SIZE (32) steps per
-/// pixel, weights in 1/32768.
-constexpr int kTabSize = 32;
-constexpr int kCoefBits = 15;
-
-// The four weights of fractional position index `frac` = 32 fy + fx, as
-// cv::remap's 8-bit bilinear table holds them: (32 - fy)(32 - fx) * 32 and
-// so on, exact but for the whole-pixel position, whose 32768 saturates to
-// 32767 and whose last weight then takes the missing 1.
-std::array<int, 4> BilinearWeights(int frac) {
-  const int fy = frac / kTabSize, fx = frac % kTabSize;
-  if (fx == 0 && fy == 0) return {32767, 0, 0, 1};
-  return {(kTabSize - fy) * (kTabSize - fx) * kTabSize, (kTabSize - fy) * fx * kTabSize,
-          fy * (kTabSize - fx) * kTabSize, fy * fx * kTabSize};
-}
-
-const std::array<std::array<int, 4>, kTabSize * kTabSize>& BilinearTable() {
-  static const std::array<std::array<int, 4>, kTabSize * kTabSize> table = [] {
-    std::array<std::array<int, 4>, kTabSize * kTabSize> t{};
-    for (int k = 0; k < kTabSize * kTabSize; ++k) t[static_cast<size_t>(k)] = BilinearWeights(k);
-    return t;
-  }();
-  return table;
-}
-
-uchar Round(int weighted) {
-  return cv::saturate_cast<uchar>((weighted + (1 << (kCoefBits - 1))) >> kCoefBits);
-}
-
 }  // namespace
-
-// cv::remap(INTER_LINEAR, BORDER_CONSTANT 0) of a CV_8UC1 image with maps
-// from cv::convertMaps(CV_16SC2), written out: remap's set-up dominates for
-// the row search's small patches. Same arithmetic, so the same pixels
-// (frontend_klt_test checks it against cv::remap).
-void RemapBilinear(const cv::Mat& src, const cv::Mat& map_xy, const cv::Mat& map_frac, cv::Mat* dst) {
-  const auto& table = BilinearTable();
-  const int width = src.cols, height = src.rows;
-  const size_t step = src.step[0];
-  for (int y = 0; y < map_xy.rows; ++y) {
-    const cv::Vec2s* xy = map_xy.ptr<cv::Vec2s>(y);
-    const ushort* frac = map_frac.ptr<ushort>(y);
-    uchar* out = dst->ptr<uchar>(y);
-    for (int x = 0; x < map_xy.cols; ++x) {
-      const int sx = xy[x][0], sy = xy[x][1];
-      const std::array<int, 4>& w = table[frac[x] & (kTabSize * kTabSize - 1)];
-      if (static_cast<unsigned>(sx) < static_cast<unsigned>(width - 1) &&
-          static_cast<unsigned>(sy) < static_cast<unsigned>(height - 1)) {
-        const uchar* p = src.data + static_cast<size_t>(sy) * step + sx;
-        out[x] = Round(p[0] * w[0] + p[1] * w[1] + p[step] * w[2] + p[step + 1] * w[3]);
-        continue;
-      }
-      if (sx >= width || sx + 1 < 0 || sy >= height || sy + 1 < 0) {
-        out[x] = 0;
-        continue;
-      }
-      auto at = [&](int u, int v) -> int {
-        return u >= 0 && v >= 0 && u < width && v < height ? src.data[static_cast<size_t>(v) * step + u] : 0;
-      };
-      out[x] = Round(at(sx, sy) * w[0] + at(sx + 1, sy) * w[1] + at(sx, sy + 1) * w[2] + at(sx + 1, sy + 1) * w[3]);
-    }
-  }
-}
 
 StereoRowSearch::StereoRowSearch(const StereoRectifier& rectifier, int patch_px, double max_disparity_px,
                                  double min_ncc)
@@ -199,8 +137,8 @@ void StereoRowSearch::BuildMaps(const StereoRectifier& rectifier, int camera) {
 }
 
 cv::Mat StereoRowSearch::Rectified(int camera, const cv::Mat& raw, const cv::Rect& roi) const {
-  cv::Mat patch(roi.size(), CV_8UC1);
-  RemapBilinear(raw, map_xy_[camera](roi), map_frac_[camera](roi), &patch);
+  cv::Mat patch;
+  cv::remap(raw, patch, map_xy_[camera](roi), map_frac_[camera](roi), cv::INTER_LINEAR, cv::BORDER_CONSTANT);
   return patch;
 }
 

@@ -30,11 +30,6 @@
 
 namespace vio::frontend {
 
-/// cv::remap(src, dst, map_xy, map_frac, INTER_LINEAR, BORDER_CONSTANT) for
-/// CV_8UC1 images and CV_16SC2 / CV_16UC1 maps (cv::convertMaps), pixel for
-/// pixel; `dst` is allocated by the caller with the maps' size.
-void RemapBilinear(const cv::Mat& src, const cv::Mat& map_xy, const cv::Mat& map_frac, cv::Mat* dst);
-
 class StereoRowSearch {
  public:
   /// Throws std::invalid_argument when patch_px is not an odd number >= 3,
