@@ -143,8 +143,9 @@ montecarlo_section
 verify_section
 
 cpu="$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)"
+software="$(dpkg-query -W -f='${Package} ${Version}, ' libceres-dev libeigen3-dev libopencv-dev g++ 2>/dev/null || true)"
 mode="full"; [ "$quick" -eq 1 ] && mode="--quick"
 python3 tools/results_tables.py page "$fragments" "$mode" "$(date -u '+%Y-%m-%d %H:%M UTC')" "$commit" \
-  "$(nproc)" "$cpu" "$((SECONDS - started))" "$(cut -d' ' -f1-3 /proc/loadavg)" > "$output.tmp"
+  "$(nproc)" "$cpu" "$((SECONDS - started))" "$(cut -d' ' -f1-3 /proc/loadavg)" "${software%, }" > "$output.tmp"
 mv "$output.tmp" "$output"
 stage "wrote $output"
