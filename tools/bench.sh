@@ -86,11 +86,13 @@ if [ ! -f "$hybrid/mav0/features0/data.csv" ]; then
 fi
 needs_images=0
 case ",$rows," in *,brisk,*|*,klt,*) needs_images=1 ;; esac
-rendered="$cache/rendered_V2_01_${rendered_s}s_stored"  # stored PNGs (vio simulate since its png_compression 0 default)
+rendered="$cache/rendered_V2_01_${rendered_s}s_textured"  # stored PNGs, real textures
 if [ "$needs_images" -eq 1 ] && [ ! -d "$rendered/mav0/cam1/data" ]; then
   echo "bench: rendering $rendered (first ${rendered_s} s of V2_01, images)"
   trim_euroc "$source_dir" "$cache/V2_01_first_${rendered_s}s" "$rendered_s"
-  "$vio" simulate --from="$cache/V2_01_first_${rendered_s}s" --camera=images --output_dir="$rendered" >/dev/null 2>&1
+  # The real textures from EUROC (the default --texture_dir is relative to the current folder).
+  "$vio" simulate --from="$cache/V2_01_first_${rendered_s}s" --camera=images --output_dir="$rendered" \
+    --texture_dir="$euroc/V1_01_easy_micro,$euroc/V1_01_easy_flight10" >/dev/null 2>&1
 fi
 
 # One row: name, dataset, description, then the run's flags; `repeat` runs,

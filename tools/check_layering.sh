@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Checks that dependencies point one way: every `#include "vio/<lib>/..."` in
-# a library's folder names that library or one it may use (README, Layout).
+# a library's folder names that library or one it may use (docs/design.md, "Library layout").
 # Prints each violation as file:line and exits 1 when there is any.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -162,7 +162,7 @@ TEST(FrontendReal, FlightMotionMatchesGroundTruth) {
     // derived from the pose-only ground truth). Translation: 2.2-2.3 cm
     // measured against the 2 cm, an open miss: vision alone gives the
     // same, and the residual fits the cameras sitting 10.6 cm further along
-    // body -y than calibrated (README "Front ends").
+    // body -y than calibrated (docs/frontends.md, "On real images").
     EXPECT_LT(error.translation().norm(), 0.025) << name;
     EXPECT_LT(Eigen::AngleAxisd(error.rotation()).angle(), 1.0 * M_PI / 180.0) << name;
   }

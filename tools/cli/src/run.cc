@@ -329,7 +329,7 @@ void WarnAboutQuestionableSettings(const RunConfig& config) {
   if (kept > 0 && !config.estimator.model.fej) {
     LOG(WARNING) << "--persistent_landmarks=" << kept
                  << " without --fej=true: the kept landmarks' relinearized observations disagree with the prior "
-                    "they are in, which usually makes the estimate worse (README: Long-lived landmarks)";
+                    "they are in, which usually makes the estimate worse (docs/design.md: Long-lived landmarks)";
   }
 }
 

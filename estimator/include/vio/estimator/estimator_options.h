@@ -23,7 +23,7 @@ struct PolicyOptions {
   /// Frames with fewer stereo observations are tracking loss: not used,
   /// propagated on the IMU (tracking_monitor.h) [count]. 1: every frame with
   /// something to track is used (better with exact simulated features, not
-  /// with image front ends: README "Frame gaps and tracking loss").
+  /// with image front ends: docs/design.md, "The estimator, frame by frame").
   int min_frame_features = 10;
 
   template <class V>

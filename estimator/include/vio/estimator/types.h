@@ -2,7 +2,7 @@
 // Basic value types shared by every library: time, typed ids, IMU samples,
 // sensor calibration, and the one struct the front end hands the estimator.
 //
-// Conventions (written once, see README "Frames and conventions"):
+// Conventions (written once, docs/design.md, "Conventions"):
 //  * Timestamps are int64 nanoseconds (`Timestamp`), never floating seconds.
 //  * `T_a_b` maps coordinates in frame b to frame a: p_a = T_a_b * p_b.
 //  * Quaternions are Hamilton, Eigen storage order (x, y, z, w).
