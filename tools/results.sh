@@ -3,12 +3,14 @@
 # per frame of batch, SWF(10) and MSCKF(10) on the hybrid EuRoC sequences
 # (`vio simulate --from`, `vio sweep`, `vio eval` in SE3 and pos+yaw), the
 # speed table of tools/bench.sh, the front ends on the real image pairs, the
-# Monte Carlo consistency of SWF(10) and MSCKF(10) and `vio verify`. Reads the
+# Monte Carlo consistency of SWF(10) and MSCKF(10), the fresh-clone `tools/demo.sh`
+# and `vio verify`. Reads the
 # shared data only ($VIO_DATA_DIR, default ../shared/data beside the repository).
 #
 # usage: tools/results.sh [--quick] [--cache=DIR] [--output=FILE]
 #   --quick   minutes instead of about half an hour: the first 30 s of V2_01 only,
-#             tools/bench.sh --quick on a 5 s rendering, 3 short Monte Carlo seeds
+#             tools/bench.sh --quick on a 5 s rendering, 3 short Monte Carlo seeds,
+#             no fresh-clone tools/demo.sh
 #   --cache   datasets and runs (default ${VIO_RESULTS_CACHE:-/tmp/vio_results});
 #             its generated folders are cleared at the start, so nothing stale is reused
 #   --output  the Markdown written (default docs/results.md)
@@ -128,7 +130,28 @@ montecarlo_section() {
   sed -n '/^## Monte Carlo/,$p' "$cache/montecarlo/results.md" | tail -n +2 | sed '/./,$!d' > "$fragments/montecarlo.md"
 }
 
-# 5. The paper's theorems through the window.
+# 5. The README's first command on a fresh clone (full mode only): the build from scratch is most of it.
+demo_section() {
+  local list="$fragments/demo.cmd" clone="$cache/demo/clone"
+  stage "tools/demo.sh on a fresh clone"
+  rm -rf "$cache/demo"; mkdir -p "$cache/demo"
+  git clone -q "$root" "$clone"
+  echo "git clone -q . $clone && cd $clone && /usr/bin/time -f '%e %U %S' tools/demo.sh" >> "$list"
+  (cd "$clone" && env -u CMAKE_ARGS -u BUILD_DIR -u OUT /usr/bin/time -f '%e %U %S' -o "$cache/demo/time.txt" \
+    tools/demo.sh > "$cache/demo/log.txt" 2>&1) || { echo "results: tools/demo.sh failed: $cache/demo/log.txt" >&2; exit 1; }
+  local wall user sys build summary
+  read -r wall user sys < "$cache/demo/time.txt"
+  build="$(sed -n 's/^build: done in \([0-9]*\) s.*/\1/p' "$cache/demo/log.txt")"
+  summary="$(grep -m1 '^SWF(10) on the simulated flight' "$cache/demo/log.txt" || echo 'no summary line')"
+  {
+    echo "| whole demo, wall | build of vio, wall | user + sys CPU | its summary line |"
+    echo "|---:|---:|---:|---|"
+    printf '| %.0f s | %s s | %.0f s | %s |\n' "$wall" "$build" "$(awk -v u="$user" -v s="$sys" 'BEGIN { print u + s }')" "$summary"
+  } > "$fragments/demo.md"
+  rm -rf "$clone"
+}
+
+# 6. The paper's theorems through the window.
 verify_section() {
   local list="$fragments/verify.cmd"
   stage "vio verify"
@@ -140,6 +163,7 @@ hybrid_section
 bench_section
 real_section
 montecarlo_section
+[ "$quick" -eq 1 ] || demo_section
 verify_section
 
 cpu="$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)"
