@@ -2,7 +2,8 @@
 # Starts in flight (docs/initialization.md): each shared hybrid sequence cut
 # 10/20/30/40 s into the recording (`vio simulate --from_start_s`), run with
 # swf and msckf 10 from that moving start (init auto), against the same span
-# cut from a full-sequence run (static start) and against the cut sequence
+# cut from a full-sequence run (static start; the cut has the full sequence's
+# measurements from the cut on, so only the start differs) and against the cut sequence
 # started from the ground truth (--init=groundtruth: the same features, so
 # the initializer's own cost). Prints a Markdown table: frames estimated,
 # status, how the run started and after how long, ATE (SE3) of the cut run, of

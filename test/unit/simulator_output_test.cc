@@ -121,6 +121,43 @@ TEST(SimulateOutputTest, ImagesNoiseSeedChangesTheSensorNoiseOnly) {
   fs::remove_all(base);
 }
 
+// A hybrid sequence cut S s in (from_start_s) is the whole sequence's simulation
+// with its start removed: from the cut on, the same features (tracks, pixel
+// noise), IMU and ground truth; a cut run is then comparable with the span of a
+// full run on the same measurements.
+TEST(SimulateOutputTest, CutHybridSequenceIsTheWholeSequenceFromTheCutOn) {
+  const std::string base = test::MakeTempDir("vio_sim_cut");
+  Simulate(Options(base + "/source", 3, SimCameraOutput::kFeatures, 8.0));
+  SimulatorOptions whole = Options(base + "/whole", 1, SimCameraOutput::kFeatures, 0.0);
+  whole.from_euroc_dir = base + "/source";
+  SimulatorOptions cut = whole;
+  cut.output_dir = base + "/cut";
+  cut.from_start_s = 5.0;
+  const Simulation a = BuildSimulation(whole);
+  const Simulation b = BuildSimulation(cut);
+  ASSERT_FALSE(b.frames.empty());
+  const Timestamp t0 = b.frames.front().t_ns;
+  EXPECT_GE(t0, a.frames.front().t_ns + SecondsToNanos(5.0));
+  std::vector<FeatureObservation> tail;
+  for (const FeatureObservation& o : a.dataset.features) {
+    if (o.t_ns >= t0) tail.push_back(o);
+  }
+  ASSERT_EQ(tail.size(), b.dataset.features.size());
+  ASSERT_FALSE(tail.empty());
+  for (std::size_t i = 0; i < tail.size(); ++i) {
+    ASSERT_EQ(tail[i].t_ns, b.dataset.features[i].t_ns) << i;
+    ASSERT_EQ(tail[i].feature_id, b.dataset.features[i].feature_id) << i;
+    ASSERT_EQ(tail[i].camera, b.dataset.features[i].camera) << i;
+    ASSERT_EQ(tail[i].uv_px, b.dataset.features[i].uv_px) << i;
+  }
+  ASSERT_EQ(b.features.cam0_count.size(), b.frames.size());
+  EXPECT_EQ(b.features.cam0_count.back(), a.features.cam0_count.back());
+  EXPECT_EQ(b.dataset.frames[0].front().t_ns, t0);
+  ASSERT_FALSE(b.dataset.imu.empty());
+  EXPECT_LE(b.dataset.imu.front().t_ns, t0);
+  fs::remove_all(base);
+}
+
 TEST(SimulateOutputTest, RejectsBadOptions) {
   EXPECT_THROW(Simulate(Options("", 1, SimCameraOutput::kFeatures, 4.0)), std::invalid_argument);
   const std::string dir = test::MakeTempDir("vio_sim_bad");

@@ -19,7 +19,8 @@ DEFINE_string(from, "", "hybrid mode: real EuRoC ASL folder whose IMU, ground tr
 DEFINE_double(from_duration_s, 0.0, "hybrid mode: only the camera frames of the first S seconds of the sequence "
               "(0: all) [s]");
 DEFINE_double(from_start_s, 0.0, "hybrid mode: cut the sequence S seconds after its first camera frame (camera, "
-              "IMU and ground truth), e.g. to start in flight [s]");
+              "IMU and ground truth), e.g. to start in flight; from the cut on, the same measurements as the whole "
+              "sequence's simulation with the same seeds [s]");
 DEFINE_double(flight_start_s, 0.0, "synthetic: how far along the flight t = 0 is: 0 starts at rest (the 3 s static "
               "start, then a 2 s ramp), 5 or more starts at full pace [s]");
 DEFINE_string(groundtruth_jumps, "remove", "hybrid mode: ground-truth steps that disagree with its own velocity by "

@@ -165,15 +165,39 @@ void BuildHybridMotion(const SimulatorOptions& options, Simulation* sim) {
   dataset.features.clear();
   dataset.has_images = false;
   sim->scene_path = PathOf(dataset.groundtruth);
+  // A cut sequence is the whole sequence's simulation with its start removed (CutFramesBefore): the frames
+  // before the cut are simulated too, so every draw from the cut on is the one the whole sequence gets.
   const Timestamp first_ns = dataset.frames[0].front().t_ns + SecondsToNanos(options.from_start_s);
-  if (options.from_start_s > 0.0) CutHybridStart(first_ns, &dataset);
+  if (options.from_start_s > 0.0 && dataset.frames[0].back().t_ns < first_ns) {
+    throw std::invalid_argument("simulator: from_start_s is past the sequence's last camera frame");
+  }
   for (const CameraFrame& row : dataset.frames[0]) {
-    if (row.t_ns < first_ns) continue;
     if (options.from_duration_s > 0.0 && row.t_ns - first_ns > SecondsToNanos(options.from_duration_s)) break;
     if (const std::optional<Eigen::Isometry3d> T_w_b = InterpolatePose(dataset.groundtruth, row.t_ns)) {
       sim->frames.push_back({row.t_ns, *T_w_b});
     }
   }
+  if (options.from_start_s > 0.0) sim->cut_ns = first_ns;
+}
+
+// from_start_s: the frames before the cut, their features, IMU and ground truth are removed.
+void CutFramesBefore(Timestamp t_ns, Simulation* sim) {
+  CutHybridStart(t_ns, &sim->dataset);
+  std::size_t kept = 0;
+  while (kept < sim->frames.size() && sim->frames[kept].t_ns < t_ns) ++kept;
+  sim->frames.erase(sim->frames.begin(), sim->frames.begin() + kept);
+  for (std::vector<CameraFrame>& rows : sim->dataset.frames) {
+    rows.erase(rows.begin(), std::lower_bound(rows.begin(), rows.end(), t_ns,
+                                              [](const CameraFrame& f, Timestamp t) { return f.t_ns < t; }));
+  }
+  FeatureSimulation& features = sim->features;
+  for (std::vector<int>* counts : {&features.cam0_count, &features.stereo_count}) {
+    counts->erase(counts->begin(), counts->begin() + std::min(kept, counts->size()));
+  }
+  std::vector<FeatureObservation>& obs = features.observations;
+  obs.erase(std::remove_if(obs.begin(), obs.end(), [t_ns](const FeatureObservation& o) { return o.t_ns < t_ns; }),
+            obs.end());
+  sim->dataset.features = obs;
 }
 
 // Features seen during a blackout are removed (and their per-frame counts).
@@ -295,6 +319,7 @@ Simulation BuildSimulation(const SimulatorOptions& options) {
     BlackOutFeatures(options.gaps.blackouts, first_frame_ns, &sim);
     sim.dataset.features = sim.features.observations;
   }
+  if (sim.cut_ns) CutFramesBefore(*sim.cut_ns, &sim);
   return sim;
 }
 

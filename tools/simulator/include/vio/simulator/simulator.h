@@ -21,6 +21,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,7 +48,8 @@ struct SimulatorOptions {
   /// from_start_s [s].
   double from_duration_s = 0.0;
   /// Hybrid mode: the sequence is cut this many seconds after its first camera frame (camera, IMU
-  /// and ground truth), e.g. to start in flight [s].
+  /// and ground truth), e.g. to start in flight [s]. The whole sequence is simulated and then cut, so
+  /// from the cut on the features and their noise are those of the uncut sequence (same seeds).
   double from_start_s = 0.0;
   /// Hybrid mode: ground-truth steps that disagree with the ground truth's own
   /// velocity by more than 5 m/s (a glitch of the reference: EuRoC MH_04 has
@@ -102,6 +104,8 @@ struct Simulation {
   /// The path the room and landmarks are built around: the whole ground truth, also when the
   /// sequence is cut (from_start_s), so a cut sequence flies through the same world.
   std::vector<Eigen::Vector3d> scene_path;
+  /// from_start_s: the first kept time; the whole sequence is simulated, then cut there.
+  std::optional<Timestamp> cut_ns;
 };
 
 struct SimulationSummary {
