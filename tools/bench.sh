@@ -59,8 +59,25 @@ BUILD_DIR="$build" "$root/tools/build.sh" vio >/dev/null
 vio="$build/bin/vio"
 pin=()
 if command -v taskset >/dev/null && taskset -c 0 true 2>/dev/null; then pin=(taskset -c 0); fi
-# The configuration without the keys an older binary does not know.
-grep -v '^  pipeline_threads:' "$root/config/euroc_stereo.yaml" > "$cache/baseline_config.yaml"
+# The configuration for the --baseline binary: without the keys it does not know (no --KEY= in its
+# `run --help`) and the values outside the choices its help lists ({a|b}): it keeps its defaults there.
+if [ -n "$baseline" ]; then
+  "$baseline" run --help > "$cache/baseline_help.txt" 2>&1 || true
+  python3 - "$root/config/euroc_stereo.yaml" "$cache/baseline_help.txt" > "$cache/baseline_config.yaml" <<'PY'
+import re, sys
+help_text = open(sys.argv[2]).read()
+for line in open(sys.argv[1]):
+    m = re.match(r"^\s+(\w+):\s*([^#\s]*)", line)
+    if m:
+        entry = re.search(r"^\s+--" + m.group(1) + r"=.*\n(.*)$", help_text, re.M)
+        if not entry:
+            continue
+        choices = re.search(r"\{([^}]*)\}\s*$", entry.group(1))
+        if choices and m.group(2).strip('"') not in choices.group(1).split("|"):
+            continue
+    sys.stdout.write(line)
+PY
+fi
 pin2=()
 if command -v taskset >/dev/null && taskset -c 0,1 true 2>/dev/null; then pin2=(taskset -c 0,1); fi
 
