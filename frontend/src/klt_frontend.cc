@@ -58,7 +58,8 @@ bool KltFrontend::Inside(const cv::Point2f& p, const cv::Mat& image) {
 KltFrontend::KltFrontend(const FrontendOptions& options, const StereoRectifier& rectifier)
     : StereoFrontend(Checked(options), rectifier),
       grid_(rectifier.camera_model(0).width(), rectifier.camera_model(0).height(), options.grid_cell_px),
-      row_search_(rectifier, kRowSearchPatchPx, options.klt_max_disparity_px, options.klt_min_ncc) {}
+      row_search_(rectifier, kRowSearchPatchPx, options.klt_max_disparity_px, options.klt_min_ncc),
+      failed_corners_(rectifier.camera_model(0).width(), rectifier.camera_model(0).height(), FailedCorners::kKltFrames) {}
 
 // The pyramids (the left one over klt_pyramid_levels for the temporal LK,
 // the right one at full resolution for the stereo LK) are built once here
@@ -76,6 +77,7 @@ void KltFrontend::PrepareImages(bool with_corners, PreparedPair* pair) const {
 
 std::vector<FrameFeature> KltFrontend::TrackFrame(PreparedPair* pair, const FramePrior& prior) {
   std::int64_t start = NowNs();
+  failed_corners_.NextFrame();
   TrackTemporal(pair->left_pyramid, prior);
   AddTime(&StageTimes::temporal_ms, start);
   start = NowNs();
@@ -283,7 +285,10 @@ void KltFrontend::DetectNew(const StereoImages& images, const PreparedPair& pair
   for (Track& t : candidates) pointers.push_back(&t);
   MatchAt(images, pointers);
   for (Track& t : candidates) {
-    if (!t.match) continue;
+    if (!t.match) {
+      failed_corners_.Remember(t.uv0_px);
+      continue;
+    }
     t.id = NewTrack();
     tracks_.push_back(t);
   }
@@ -293,8 +298,9 @@ void KltFrontend::DetectNew(const StereoImages& images, const PreparedPair& pair
 // fewer than r features one more, up to klt_per_cell per cell and
 // klt_max_features in all (none while fewer than kMinMissingFraction of them
 // are missing); a corner must be klt_min_distance_px from every
-// feature and found by the row search (at most kSearchesPerWantedFeature
-// tries per wanted feature and cell).
+// feature, found by the row search (at most kSearchesPerWantedFeature
+// tries per wanted feature and cell) and not near a corner that failed
+// recently (failed_corners_).
 std::vector<KltFrontend::Track> KltFrontend::Candidates(const StereoImages& images, const PreparedPair& pair) {
   std::vector<int>& per_cell = per_cell_;
   const int per_cell_max = options().klt_per_cell;
@@ -316,12 +322,16 @@ std::vector<KltFrontend::Track> KltFrontend::Candidates(const StereoImages& imag
       if (static_cast<int>(candidates.size()) >= wanted) return candidates;
       const auto cell = static_cast<size_t>(grid_.Cell(corner.pt));
       const cv::Point pixel(cvRound(corner.pt.x), cvRound(corner.pt.y));
-      if (per_cell[cell] >= round || searches[cell] >= search_budget[cell] || mask_.at<uchar>(pixel) == 0) {
+      if (per_cell[cell] >= round || searches[cell] >= search_budget[cell] || mask_.at<uchar>(pixel) == 0 ||
+          failed_corners_.Recent(corner.pt)) {
         continue;
       }
       ++searches[cell];
       const std::optional<double> disparity = SearchRow(images, corner.pt);
-      if (!disparity) continue;
+      if (!disparity) {
+        failed_corners_.Remember(corner.pt);
+        continue;
+      }
       ++per_cell[cell];
       cv::circle(mask_, pixel, radius, cv::Scalar(0), cv::FILLED);
       Track t;

@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "euroc_calibration.h"
+#include "vio/frontend/failed_corners.h"
 #include "vio/frontend/stereo_frontend.h"
 #include "vio/frontend/stereo_row_search.h"
 
@@ -235,6 +236,34 @@ void DistortedPlaneTest::ExpectSameFramesWithPreparedCorners(const FrontendOptio
     }
   }
   EXPECT_GT(per_cell->stats().new_tracks, per_cell->stats().observations_per_frame.front());
+}
+
+// The same pair again and again, its right image flat on the right half:
+// the left corners seen there find no stereo match. The detection tries
+// each once, then again only after FailedCorners::kKltFrames frames.
+TEST_F(DistortedPlaneTest, KltDoesNotRetryCornersThatFailedRecently) {
+  FrontendOptions options;
+  options.frontend = "klt";
+  options.klt_max_features = 1000;  // the open cells keep wanting features
+  auto frontend = MakeStereoFrontend(options, rectifier_);
+  RawPair pair = MakePair(rectifier_, texture_, 30.0);
+  pair.right.colRange(pair.right.cols / 2, pair.right.cols).setTo(cv::Scalar(128));
+  std::vector<std::int64_t> searches;
+  for (int k = 0; k < FailedCorners::kKltFrames + 3; ++k) {
+    const std::int64_t before = frontend->stats().row_searches;
+    frontend->Process(k, pair.left, pair.right, FramePrior{});
+    searches.push_back(frontend->stats().row_searches - before);
+  }
+  // Each frame tries the next corners of the open cells (the search budget
+  // is per frame) until none is left; the first frame's failures expire after
+  // kKltFrames frames (more than 500 searches a frame without the memory).
+  const size_t expired = FailedCorners::kKltFrames + 1;
+  std::int64_t in_between = 0;
+  for (size_t k = 1; k < expired; ++k) in_between += searches[k];
+  EXPECT_GT(searches[0], 500);
+  EXPECT_LT(in_between, 3 * searches[0]);
+  for (size_t k = expired - 3; k < expired; ++k) EXPECT_LE(searches[k], searches[0] / 50) << "frame " << k;
+  EXPECT_GT(searches[expired], searches[0] / 4);
 }
 
 TEST_F(DistortedPlaneTest, KltRejectsABadFeatureBudget) {

@@ -27,7 +27,10 @@
 //             whole image come prepared: the same corners); a corner
 //             becomes a feature only when the row search finds it in the
 //             right image and the stereo LK from there passes both checks,
-//             so every new feature is a stereo observation at once;
+//             so every new feature is a stereo observation at once; a
+//             corner that found none is not tried again for
+//             FailedCorners::kKltFrames frames where a corner is found again
+//             at (about) the same pixel (FailedCorners);
 //   re-identify (reidentify_radius_px > 0; after detect's thinning, before
 //             its new corners) the landmarks the estimator holds
 //             (FramePrior::landmarks) that are no current track, by the 21 px
@@ -61,6 +64,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include "vio/frontend/failed_corners.h"
 #include "vio/frontend/feature_grid.h"
 #include "vio/frontend/stereo_frontend.h"
 #include "vio/frontend/stereo_row_search.h"
@@ -164,6 +168,8 @@ class KltFrontend final : public StereoFrontend {
 
   FeatureGrid grid_;
   StereoRowSearch row_search_;
+  /// New corners that found no stereo match in the last frames: not tried again.
+  FailedCorners failed_corners_;
   std::vector<cv::Mat> previous_left_;  ///< pyramid of the previous left image
   std::vector<Track> tracks_;           ///< features of the left image
   /// Per-frame buffers, kept to reuse their memory: where new corners may go
