@@ -16,6 +16,7 @@
 #include "vio/frontend/stereo_frontend.h"
 #include "vio/frontend/track_drawing.h"
 #include "pair_pipeline.h"
+#include "vio/dataset/image_file.h"
 #include "vio/dataset/rosbag_dataset.h"
 
 namespace vio::tools {
@@ -151,7 +152,7 @@ class ImageFrameSource final : public FrameSource {
       return;
     }
     const std::string path = mav0_ + "/cam" + std::to_string(camera) + "/data/" + filenames_[camera][row];
-    *image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    *image = ReadGreyImage(path);
     if (image->empty()) throw std::runtime_error(path + ": cannot read the image");
   }
 
