@@ -12,24 +12,30 @@ FailedCorners::FailedCorners(int width_px, int height_px, int frames)
     throw std::invalid_argument("FailedCorners: image size and frames must be positive");
   }
   failed_.assign(static_cast<size_t>(cols_) * static_cast<size_t>(rows_), 0);
+  how_.assign(failed_.size(), CornerFailure::kNone);
 }
 
 int FailedCorners::Bin(int col, int row) const {
   return std::clamp(row, 0, rows_ - 1) * cols_ + std::clamp(col, 0, cols_ - 1);
 }
 
-void FailedCorners::Remember(const cv::Point2f& uv_px) {
+void FailedCorners::Remember(const cv::Point2f& uv_px, CornerFailure how) {
   const int col = static_cast<int>(std::floor(uv_px.x / kBinPx));
   const int row = static_cast<int>(std::floor(uv_px.y / kBinPx));
   for (int r = row - 1; r <= row + 1; ++r) {
-    for (int c = col - 1; c <= col + 1; ++c) failed_[static_cast<size_t>(Bin(c, r))] = frame_ + 1;
+    for (int c = col - 1; c <= col + 1; ++c) {
+      const auto bin = static_cast<size_t>(Bin(c, r));
+      failed_[bin] = frame_ + 1;
+      how_[bin] = how;
+    }
   }
 }
 
-bool FailedCorners::Recent(const cv::Point2f& uv_px) const {
-  const int stamp = failed_[static_cast<size_t>(Bin(static_cast<int>(std::floor(uv_px.x / kBinPx)),
-                                                    static_cast<int>(std::floor(uv_px.y / kBinPx))))];
-  return stamp > 0 && frame_ - (stamp - 1) <= frames_;
+CornerFailure FailedCorners::Recent(const cv::Point2f& uv_px) const {
+  const auto bin = static_cast<size_t>(Bin(static_cast<int>(std::floor(uv_px.x / kBinPx)),
+                                           static_cast<int>(std::floor(uv_px.y / kBinPx))));
+  const int stamp = failed_[bin];
+  return stamp > 0 && frame_ - (stamp - 1) <= frames_ ? how_[bin] : CornerFailure::kNone;
 }
 
 }  // namespace vio::frontend

@@ -41,6 +41,8 @@ constexpr double kMinMissingFraction = 0.05;
 /// (0.97-1.03) per sequence, moved by +4, -6, -9 % (MSCKF(10)) and -4,
 /// -2.5, -2 % (SWF(10)) [count].
 constexpr int kPredictedPyramidLevels = 0;
+/// TrackPoints' agree_px that always checks backward [px].
+constexpr double kNoAgreement = -1.0;
 /// Features unmatched left-right for more consecutive frames are dropped.
 constexpr int kMaxFramesWithoutStereo = 3;
 FrontendOptions Checked(const FrontendOptions& options) {
@@ -113,22 +115,35 @@ void KltFrontend::DropTracks(const std::vector<LandmarkId>& rejected) {
 
 std::vector<bool> KltFrontend::TrackPoints(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
                                            const std::vector<cv::Point2f>& points,
-                                           std::vector<cv::Point2f>* guess, int levels) const {
+                                           std::vector<cv::Point2f>* guess, int levels, double agree_px) const {
   std::vector<bool> kept(points.size(), false);
   if (points.empty()) return kept;
   const cv::Size window(options().klt_window_px, options().klt_window_px);
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
   std::vector<uchar> status, back_status;
+  const std::vector<cv::Point2f> seeds = *guess;
   // No error output: OpenCV then skips the extra pass over each window that
   // computes it.
   cv::calcOpticalFlowPyrLK(from, to, points, *guess, status, cv::noArray(), window, levels, criteria,
                            cv::OPTFLOW_USE_INITIAL_FLOW);
-  std::vector<cv::Point2f> back = points;
-  cv::calcOpticalFlowPyrLK(to, from, *guess, back, back_status, cv::noArray(), window, levels, criteria,
+  std::vector<size_t> check;
+  std::vector<cv::Point2f> forward, back;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!status[i] || !Inside((*guess)[i], to[0])) continue;
+    if (cv::norm((*guess)[i] - seeds[i]) <= agree_px) {
+      kept[i] = true;
+      continue;
+    }
+    check.push_back(i);
+    forward.push_back((*guess)[i]);
+    back.push_back(points[i]);
+  }
+  if (check.empty()) return kept;
+  cv::calcOpticalFlowPyrLK(to, from, forward, back, back_status, cv::noArray(), window, levels, criteria,
                            cv::OPTFLOW_USE_INITIAL_FLOW);
   const double max_fb = options().klt_max_fb_px;
-  for (size_t i = 0; i < points.size(); ++i) {
-    kept[i] = status[i] && back_status[i] && Inside((*guess)[i], to[0]) && cv::norm(back[i] - points[i]) <= max_fb;
+  for (size_t j = 0; j < check.size(); ++j) {
+    kept[check[j]] = back_status[j] && cv::norm(back[j] - points[check[j]]) <= max_fb;
   }
   return kept;
 }
@@ -148,13 +163,13 @@ void KltFrontend::TrackTemporal(const std::vector<cv::Mat>& left, const FramePri
   }
   std::vector<bool> kept(tracks_.size(), false);
   std::vector<cv::Point2f> moved(tracks_.size());
-  TrackSome(left, predicted, guesses, kPredictedPyramidLevels, &kept, &moved);
+  TrackSome(left, predicted, guesses, kPredictedPyramidLevels, kNoAgreement, &kept, &moved);
   for (size_t i : predicted) {
     if (!kept[i]) rest.push_back(i);
   }
   guesses.clear();
   for (size_t i : rest) guesses.push_back(tracks_[i].uv0_px);
-  TrackSome(left, rest, guesses, options().klt_pyramid_levels, &kept, &moved);
+  TrackSome(left, rest, guesses, options().klt_pyramid_levels, kNoAgreement, &kept, &moved);
   std::vector<Track> survivors;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (!kept[i]) continue;
@@ -168,11 +183,11 @@ void KltFrontend::TrackTemporal(const std::vector<cv::Mat>& left, const FramePri
 }
 
 void KltFrontend::TrackSome(const std::vector<cv::Mat>& left, const std::vector<size_t>& which,
-                            std::vector<cv::Point2f> guesses, int levels, std::vector<bool>* kept,
+                            std::vector<cv::Point2f> guesses, int levels, double agree_px, std::vector<bool>* kept,
                             std::vector<cv::Point2f>* moved) const {
   std::vector<cv::Point2f> points;
   for (size_t i : which) points.push_back(tracks_[i].uv0_px);
-  const std::vector<bool> ok = TrackPoints(previous_left_, left, points, &guesses, levels);
+  const std::vector<bool> ok = TrackPoints(previous_left_, left, points, &guesses, levels, agree_px);
   for (size_t j = 0; j < which.size(); ++j) {
     (*kept)[which[j]] = ok[j];
     (*moved)[which[j]] = guesses[j];
@@ -207,7 +222,7 @@ void KltFrontend::MatchTracks(const StereoImages& images) {
     t.match.reset();
     all.push_back(&t);
   }
-  MatchAt(images, all);
+  MatchAt(images, all, kNoAgreement);
   std::vector<Track*> retry;
   for (Track& t : tracks_) {
     if (t.match) continue;
@@ -216,7 +231,7 @@ void KltFrontend::MatchTracks(const StereoImages& images) {
     t.disparity_px = *d;
     retry.push_back(&t);
   }
-  MatchAt(images, retry);
+  MatchAt(images, retry, kNoAgreement);
 }
 
 std::optional<double> KltFrontend::SearchRow(const StereoImages& images, const cv::Point2f& uv0_px) {
@@ -228,14 +243,14 @@ std::optional<double> KltFrontend::SearchRow(const StereoImages& images, const c
 
 // LK from the right pixel at each track's disparity, forward-backward
 // checked, then the epipolar check.
-void KltFrontend::MatchAt(const StereoImages& images, const std::vector<Track*>& tracks) {
+void KltFrontend::MatchAt(const StereoImages& images, const std::vector<Track*>& tracks, double agree_px) {
   std::vector<cv::Point2f> points, matched;
   for (const Track* t : tracks) {
     points.push_back(t->uv0_px);
     matched.push_back(RightPixelAt(t->uv0_px, t->disparity_px));
   }
   const std::vector<bool> kept = TrackPoints(images.left_pyramid, images.right_pyramid, points, &matched,
-                                             kStereoPyramidLevels);
+                                             kStereoPyramidLevels, agree_px);
   for (size_t j = 0; j < tracks.size(); ++j) {
     if (!kept[j]) continue;
     const Eigen::Vector2d uv1(matched[j].x, matched[j].y);
@@ -283,10 +298,10 @@ void KltFrontend::DetectNew(const StereoImages& images, const PreparedPair& pair
   std::vector<Track> candidates = Candidates(images, pair);
   std::vector<Track*> pointers;
   for (Track& t : candidates) pointers.push_back(&t);
-  MatchAt(images, pointers);
+  MatchAt(images, pointers, kNoAgreement);
   for (Track& t : candidates) {
     if (!t.match) {
-      failed_corners_.Remember(t.uv0_px);
+      failed_corners_.Remember(t.uv0_px, CornerFailure::kStereoMatch);
       continue;
     }
     t.id = NewTrack();
@@ -298,9 +313,12 @@ void KltFrontend::DetectNew(const StereoImages& images, const PreparedPair& pair
 // fewer than r features one more, up to klt_per_cell per cell and
 // klt_max_features in all (none while fewer than kMinMissingFraction of them
 // are missing); a corner must be klt_min_distance_px from every
-// feature, found by the row search (at most kSearchesPerWantedFeature
-// tries per wanted feature and cell) and not near a corner that failed
-// recently (failed_corners_).
+// feature and found by the row search (at most kSearchesPerWantedFeature
+// tries per wanted feature and cell). A corner near one that failed in the
+// last FailedCorners::kKltFrames frames (failed_corners_) fails as that one
+// did without a row search or LK: it uses the cell's budget, and when that
+// one failed in the stereo LK it also takes its place in the cell and the
+// mask, as it would if tried again on the same images.
 std::vector<KltFrontend::Track> KltFrontend::Candidates(const StereoImages& images, const PreparedPair& pair) {
   std::vector<int>& per_cell = per_cell_;
   const int per_cell_max = options().klt_per_cell;
@@ -317,23 +335,29 @@ std::vector<KltFrontend::Track> KltFrontend::Candidates(const StereoImages& imag
     search_budget[c] = kSearchesPerWantedFeature * std::max(0, per_cell_max - per_cell[c]);
   }
   const int radius = static_cast<int>(options().klt_min_distance_px);
+  int taken = 0;  // candidates, and the corners standing for one that failed in stereo
   for (int round = 1; round <= per_cell_max; ++round) {
     for (const cv::KeyPoint& corner : corners) {
-      if (static_cast<int>(candidates.size()) >= wanted) return candidates;
+      if (taken >= wanted) return candidates;
       const auto cell = static_cast<size_t>(grid_.Cell(corner.pt));
       const cv::Point pixel(cvRound(corner.pt.x), cvRound(corner.pt.y));
-      if (per_cell[cell] >= round || searches[cell] >= search_budget[cell] || mask_.at<uchar>(pixel) == 0 ||
-          failed_corners_.Recent(corner.pt)) {
+      if (per_cell[cell] >= round || searches[cell] >= search_budget[cell] || mask_.at<uchar>(pixel) == 0) {
         continue;
       }
       ++searches[cell];
-      const std::optional<double> disparity = SearchRow(images, corner.pt);
+      // A corner that failed here recently fails as it did, without trying.
+      const CornerFailure failed = failed_corners_.Recent(corner.pt);
+      if (failed == CornerFailure::kRowSearch) continue;
+      const std::optional<double> disparity =
+          failed == CornerFailure::kNone ? SearchRow(images, corner.pt) : std::optional<double>(0.0);
       if (!disparity) {
-        failed_corners_.Remember(corner.pt);
+        failed_corners_.Remember(corner.pt, CornerFailure::kRowSearch);
         continue;
       }
       ++per_cell[cell];
+      ++taken;
       cv::circle(mask_, pixel, radius, cv::Scalar(0), cv::FILLED);
+      if (failed == CornerFailure::kStereoMatch) continue;
       Track t;
       t.uv0_px = corner.pt;
       t.disparity_px = *disparity;

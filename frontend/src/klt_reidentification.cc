@@ -94,7 +94,7 @@ std::set<LandmarkId> KltFrontend::Reidentify(const StereoImages& images, const F
   }
   std::vector<Track*> pointers;
   for (Track& t : candidates) pointers.push_back(&t);
-  MatchAt(images, pointers);
+  MatchAt(images, pointers, /*agree_px=*/-1.0);
   for (const Track& t : candidates) {
     if (!t.match) continue;
     given.insert(t.id);

@@ -13,33 +13,36 @@ TEST(FailedCorners, RemembersAFailureNearItsPixelForItsFrames) {
   FailedCorners failed(752, 480, 3);
   failed.NextFrame();
   const cv::Point2f corner(100.4f, 200.7f);
-  EXPECT_FALSE(failed.Recent(corner));
-  failed.Remember(corner);
-  EXPECT_TRUE(failed.Recent(corner));  // in its own frame (a later round of the same detection)
-  for (int frame = 1; frame <= 3; ++frame) {
+  const cv::Point2f other(300.0f, 20.0f);
+  EXPECT_EQ(failed.Recent(corner), CornerFailure::kNone);
+  failed.Remember(corner, CornerFailure::kRowSearch);
+  failed.Remember(other, CornerFailure::kStereoMatch);
+  // In its own frame (a later round of the same detection), then 3 more.
+  for (int frame = 0; frame <= 3; ++frame) {
+    EXPECT_EQ(failed.Recent(corner), CornerFailure::kRowSearch) << frame;
+    EXPECT_EQ(failed.Recent(corner + cv::Point2f(1.0f, -1.0f)), CornerFailure::kRowSearch) << frame;
+    EXPECT_EQ(failed.Recent(corner + cv::Point2f(-1.5f, 1.2f)), CornerFailure::kRowSearch) << frame;
+    EXPECT_EQ(failed.Recent(corner + cv::Point2f(6.0f, 0.0f)), CornerFailure::kNone) << frame;
+    EXPECT_EQ(failed.Recent(corner + cv::Point2f(0.0f, -6.0f)), CornerFailure::kNone) << frame;
+    EXPECT_EQ(failed.Recent(other), CornerFailure::kStereoMatch) << frame;
     failed.NextFrame();
-    EXPECT_TRUE(failed.Recent(corner)) << frame;
-    EXPECT_TRUE(failed.Recent(corner + cv::Point2f(1.0f, -1.0f))) << frame;
-    EXPECT_TRUE(failed.Recent(corner + cv::Point2f(-1.5f, 1.2f))) << frame;
-    EXPECT_FALSE(failed.Recent(corner + cv::Point2f(6.0f, 0.0f))) << frame;
-    EXPECT_FALSE(failed.Recent(corner + cv::Point2f(0.0f, -6.0f))) << frame;
   }
-  failed.NextFrame();
-  EXPECT_FALSE(failed.Recent(corner));
+  EXPECT_EQ(failed.Recent(corner), CornerFailure::kNone);
+  EXPECT_EQ(failed.Recent(other), CornerFailure::kNone);
 }
 
 TEST(FailedCorners, ANewFailureRestartsTheCountAndTheBordersAreClamped) {
   FailedCorners failed(101, 53, 2);
   const cv::Point2f corner(0.0f, 52.9f);
-  failed.Remember(corner);
+  failed.Remember(corner, CornerFailure::kRowSearch);
   failed.NextFrame();
-  failed.Remember(corner);
+  failed.Remember(corner, CornerFailure::kStereoMatch);
   failed.NextFrame();
   failed.NextFrame();
-  EXPECT_TRUE(failed.Recent(corner));
-  EXPECT_TRUE(failed.Recent(cv::Point2f(-3.0f, 60.0f)));  // outside: the border bin
+  EXPECT_EQ(failed.Recent(corner), CornerFailure::kStereoMatch);
+  EXPECT_EQ(failed.Recent(cv::Point2f(-3.0f, 60.0f)), CornerFailure::kStereoMatch);  // outside: the border bin
   failed.NextFrame();
-  EXPECT_FALSE(failed.Recent(corner));
+  EXPECT_EQ(failed.Recent(corner), CornerFailure::kNone);
 }
 
 TEST(FailedCorners, RejectsBadSizes) {

@@ -1,14 +1,22 @@
 #pragma once
 // Where the KLT detection's new corners recently failed to become features
-// (no stereo match: the row search or the left-right LK failed). A corner
-// found again at the same place within a few frames is not tried again: on a
-// still or slow view the same corners fail every frame, and each try costs a
-// row search (and often a stereo LK).
+// (no stereo match: the row search or the left-right LK failed), and how. A
+// corner found again at the same place within a few frames is taken to fail
+// the same way without trying: on a still or slow view the same corners fail
+// every frame, and each try costs a row search (and often a stereo LK).
+#include <cstdint>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 namespace vio::frontend {
+
+/// How a corner failed to become a feature.
+enum class CornerFailure : std::uint8_t {
+  kNone,        ///< no failure remembered
+  kRowSearch,   ///< the row search found no disparity
+  kStereoMatch  ///< the row search found one, the left-right LK failed from it
+};
 
 class FailedCorners {
  public:
@@ -18,20 +26,16 @@ class FailedCorners {
 
   /// Starts the next frame: failures older than `frames` frames expire.
   void NextFrame() { ++frame_; }
-  /// A corner at `uv_px` failed in this frame.
-  void Remember(const cv::Point2f& uv_px);
-  /// Whether a corner failed near `uv_px` (in its bin or one next to it) in
-  /// this frame or one of the last `frames` frames.
-  bool Recent(const cv::Point2f& uv_px) const;
+  /// A corner at `uv_px` failed in this frame, as `how` says.
+  void Remember(const cv::Point2f& uv_px, CornerFailure how);
+  /// How the last corner near `uv_px` (in its bin or one next to it) failed
+  /// in this frame or one of the last `frames` frames; kNone when none did.
+  CornerFailure Recent(const cv::Point2f& uv_px) const;
 
   /// Side of the square bins failures are kept in [px]; a failure marks its
   /// bin and the 8 around it.
   static constexpr int kBinPx = 2;
-  /// How long the KLT front end remembers a failure: on the still real clip
-  /// V1_01_easy_micro the row searches per frame fall from 136 to 21 with 10
-  /// frames (12 with 30, 36 with 4); on the rendered V2_01 20 s the ATE of
-  /// KLT + MSCKF(10) was 0.0111, 0.0099, 0.0123 m with 4, 10, 30 frames
-  /// (0.0109 m without the memory) [frames].
+  /// How long the KLT front end remembers a failure [frames].
   static constexpr int kKltFrames = 10;
 
  private:
@@ -41,8 +45,9 @@ class FailedCorners {
   int cols_, rows_;
   int frames_;
   int frame_ = 0;
-  /// Per bin: 1 + the frame of its last failure; 0: none.
+  /// Per bin: 1 + the frame of its last failure (0: none), and how.
   std::vector<int> failed_;
+  std::vector<CornerFailure> how_;
 };
 
 }  // namespace vio::frontend

@@ -28,9 +28,9 @@
 //             becomes a feature only when the row search finds it in the
 //             right image and the stereo LK from there passes both checks,
 //             so every new feature is a stereo observation at once; a
-//             corner that found none is not tried again for
-//             FailedCorners::kKltFrames frames where a corner is found again
-//             at (about) the same pixel (FailedCorners);
+//             corner found where one failed in the last
+//             FailedCorners::kKltFrames frames is taken to fail the same way
+//             without a row search or LK (FailedCorners);
 //   re-identify (reidentify_radius_px > 0; after detect's thinning, before
 //             its new corners) the landmarks the estimator holds
 //             (FramePrior::landmarks) that are no current track, by the 21 px
@@ -105,15 +105,18 @@ class KltFrontend final : public StereoFrontend {
   };
 
   /// Forward-backward LK from `from` to `to`; `guess` is the initial position
-  /// in `to` (updated to the result). Returns per point whether it is kept.
+  /// in `to` (updated to the result). Returns per point whether it is kept:
+  /// the forward LK converged inside the image and either ended within
+  /// `agree_px` of its guess or tracking back lands within klt_max_fb_px of
+  /// the start (the backward LK runs only for those points).
   std::vector<bool> TrackPoints(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
                                 const std::vector<cv::Point2f>& points, std::vector<cv::Point2f>* guess,
-                                int levels) const;
+                                int levels, double agree_px) const;
   void TrackTemporal(const std::vector<cv::Mat>& left, const FramePrior& prior);
   /// TrackPoints from the previous left image for the tracks `which`, from
   /// `guesses`; writes their results into `kept` and `moved` (per track).
   void TrackSome(const std::vector<cv::Mat>& left, const std::vector<size_t>& which,
-                 std::vector<cv::Point2f> guesses, int levels, std::vector<bool>* kept,
+                 std::vector<cv::Point2f> guesses, int levels, double agree_px, std::vector<bool>* kept,
                  std::vector<cv::Point2f>* moved) const;
   /// Where the track's landmark should appear in the left image, seen from
   /// the predicted pose; nullopt without a prediction or a position.
@@ -130,8 +133,8 @@ class KltFrontend final : public StereoFrontend {
   /// The row search's disparity of a left pixel (nullopt: none found).
   std::optional<double> SearchRow(const StereoImages& images, const cv::Point2f& uv0_px);
   /// LK left -> right for `tracks`, each seeded at its disparity_px; sets the
-  /// match of those passing the checks.
-  void MatchAt(const StereoImages& images, const std::vector<Track*>& tracks);
+  /// match of those passing the checks (TrackPoints' agree_px).
+  void MatchAt(const StereoImages& images, const std::vector<Track*>& tracks, double agree_px);
   /// The right image's pixel of a left pixel at a rectified disparity.
   cv::Point2f RightPixelAt(const cv::Point2f& uv0_px, double disparity_px) const;
   /// Drops features without a stereo match for too long, the younger of two
