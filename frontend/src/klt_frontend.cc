@@ -70,7 +70,8 @@ KltFrontend::KltFrontend(const FrontendOptions& options, const StereoRectifier& 
     : StereoFrontend(Checked(options), rectifier),
       grid_(rectifier.camera_model(0).width(), rectifier.camera_model(0).height(), options.grid_cell_px),
       row_search_(rectifier, kRowSearchPatchPx, options.klt_max_disparity_px, options.klt_min_ncc),
-      failed_corners_(rectifier.camera_model(0).width(), rectifier.camera_model(0).height(), FailedCorners::kKltFrames) {}
+      failed_corners_(rectifier.camera_model(0).width(), rectifier.camera_model(0).height(),
+                      FailedCorners::kKltFrames) {}
 
 // The pyramids (the left one over klt_pyramid_levels for the temporal LK,
 // the right one at full resolution for the stereo LK) are built once here

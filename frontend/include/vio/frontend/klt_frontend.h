@@ -3,9 +3,9 @@
 //   temporal  the left image's features are tracked from the previous left
 //             image (calcOpticalFlowPyrLK) and kept only when tracking back
 //             lands within klt_max_fb_px of the start (forward-backward
-//             check; skipped when the forward LK ends within 0.3 px of the
-//             IMU-predicted pixel; both pyramids are built once per frame, in Prepare,
-//             and the left one serves the next frame); a track whose
+//             check, skipped when the forward LK ends within 0.3 px of the
+//             IMU-predicted pixel; both pyramids are built once per frame,
+//             in Prepare, and the left one serves the next frame); a track whose
 //             landmark has a position starts at its
 //             projection into the IMU-predicted camera and uses two pyramid
 //             levels, the others (and those that fail) start where they were
@@ -15,8 +15,8 @@
 //             the epipolar check on rectified rows; the initial guess is the
 //             right pixel on the same rectified row at the feature's last
 //             disparity (no backward LK when the forward one ends within
-//             0.3 px of it); when that fails, at the disparity a 1-D ZNCC search
-//             along the rectified row finds (StereoRowSearch, disparities up
+//             0.3 px of it); when that fails, at the disparity a 1-D ZNCC
+//             search along the rectified row finds (StereoRowSearch, disparities up
 //             to klt_max_disparity_px);
 //   detect    features closer than klt_min_distance_px to an older one, or
 //             beyond klt_per_cell in their grid cell, are dropped (youngest
