@@ -89,14 +89,27 @@ ActiveSet SelectActiveSet(const LocalMapData& map, int keyframes) {
   return set;
 }
 
-std::vector<StateId> LocalMap::Prepare(const StereoFrame& frame, StateId state, Window& window) {
+StereoFrame LocalMap::Prepare(const StereoFrame& frame, StateId state, Window& window, std::vector<StateId>* parked) {
   std::vector<LandmarkId> landmarks;
-  for (const StereoObservation& obs : frame.observations) landmarks.push_back(obs.landmark);
+  std::set<LandmarkId> in_cost;  // gated by the estimator already
+  for (const StereoObservation& obs : frame.observations) {
+    landmarks.push_back(obs.landmark);
+    if (window.HasLandmark(obs.landmark)) in_cost.insert(obs.landmark);
+  }
   if (IsKeyframe(landmarks, data_, options_.local_map_overlap)) data_.recent_keyframes.insert(state);
   data_.recent[state] = landmarks;
-  std::vector<StateId> parked;
-  Apply(SelectActiveSet(data_, options_.local_map_keyframes), landmarks, window, &parked);
-  return parked;
+  Apply(SelectActiveSet(data_, options_.local_map_keyframes), frame, state, window, parked);
+  StereoFrame gated = frame;
+  gated.observations.clear();
+  for (const StereoObservation& obs : frame.observations) {
+    const bool returned = window.HasLandmark(obs.landmark) && in_cost.count(obs.landmark) == 0;
+    if (returned && !(window.WhitenedError(state, obs.landmark, obs.z_px) <= gate_sigma_)) {
+      ++counts_.gated;
+      continue;
+    }
+    gated.observations.push_back(obs);
+  }
+  return gated;
 }
 
 std::optional<StateId> LocalMap::KeyframeLeaving() const {
@@ -110,7 +123,10 @@ std::vector<StateId> LocalMap::Slide(Window& window) {
   std::vector<StateId> dropped;
   if (static_cast<int>(data_.recent.size()) > window_size_) {
     const StateId oldest = data_.recent.begin()->first;
-    if (data_.recent_keyframes.erase(oldest) > 0) {
+    const bool long_link = !data_.keyframes.empty() &&
+                           window.state(std::next(data_.recent.begin())->first).t_ns -
+                                   data_.keyframes.rbegin()->second.state.t_ns > max_link_ns_;
+    if (data_.recent_keyframes.erase(oldest) > 0 || long_link) {
       JoinMap(oldest, window);
     } else {
       window.DropState(oldest);
@@ -138,7 +154,7 @@ void LocalMap::JoinMap(StateId id, Window& window) {
   ++counts_.keyframes;
 }
 
-void LocalMap::Apply(const ActiveSet& set, const std::vector<LandmarkId>& frame_landmarks, Window& window,
+void LocalMap::Apply(const ActiveSet& set, const StereoFrame& frame, StateId state, Window& window,
                      std::vector<StateId>* parked) {
   const auto wanted = [&](StateId id) { return set.active.count(id) > 0 || set.fixed.count(id) > 0; };
   std::vector<StateId> leaving;
@@ -151,9 +167,16 @@ void LocalMap::Apply(const ActiveSet& set, const std::vector<LandmarkId>& frame_
       if (data_.live.count(id) == 0) Unpark(id, window);
     }
   }
-  for (StateId id : data_.live) window.SetStateConstant(id, set.fixed.count(id) > 0);
+  // Active keyframes free their poses; their speed/bias only for the newest, which the IMU
+  // factor into the recent window ties to it (the others' stay as last estimated: 9 fewer
+  // dense columns each).
+  const StateId newest = data_.keyframes.empty() ? StateId() : data_.keyframes.rbegin()->first;
+  for (StateId id : data_.live) {
+    window.SetStateConstant(id, set.fixed.count(id) > 0);
+    if (set.fixed.count(id) == 0 && id != newest) window.SetSpeedBiasConstant(id, true);
+  }
   LinkChain(window);
-  SyncLandmarks(set, frame_landmarks, window);
+  SyncLandmarks(set, frame, state, window);
   AddKeyframeObservations(window);
   parked->insert(parked->end(), leaving.begin(), leaving.end());
 }
@@ -195,8 +218,9 @@ void LocalMap::LinkChain(Window& window) const {
 
 // Landmarks in the cost: those the recent frames and the active keyframes see. The others
 // (seen from fixed keyframes only, or from no state in the cost) are parked with their estimate;
-// parked ones the cost needs again come back when a state in it observes them.
-void LocalMap::SyncLandmarks(const ActiveSet& set, const std::vector<LandmarkId>& frame_landmarks, Window& window) {
+// parked ones the cost needs again come back when a state in it observes them, the frame's
+// own observation within the gate (else the frame sees a new landmark).
+void LocalMap::SyncLandmarks(const ActiveSet& set, const StereoFrame& frame, StateId state, Window& window) {
   std::set<LandmarkId> needed = RecentLandmarks(data_);
   for (StateId id : set.active) {
     for (const auto& [landmark, z] : data_.keyframes.at(id).observations) needed.insert(landmark);
@@ -210,22 +234,35 @@ void LocalMap::SyncLandmarks(const ActiveSet& set, const std::vector<LandmarkId>
     if (it != data_.landmarks.end()) it->second.p_w = window.landmark(id).position();
     window.DropLandmark(id);
   }
-  const std::set<LandmarkId> in_frame(frame_landmarks.begin(), frame_landmarks.end());
+  std::map<LandmarkId, Eigen::Vector3d> in_frame;
+  for (const StereoObservation& obs : frame.observations) in_frame[obs.landmark] = obs.z_px;
   for (LandmarkId id : needed) {
     auto it = data_.landmarks.find(id);
     if (window.HasLandmark(id) || it == data_.landmarks.end()) continue;
     const bool seen_live = std::any_of(it->second.keyframes.begin(), it->second.keyframes.end(),
                                        [&](StateId k) { return data_.live.count(k) > 0; });
-    if (!seen_live && in_frame.count(id) == 0) continue;
+    auto z = in_frame.find(id);
+    if (!seen_live && z == in_frame.end()) continue;
     window.AddLandmark(id, it->second.p_w);
-    if (in_frame.count(id) > 0) ++counts_.landmark_returns;
+    if (z == in_frame.end()) continue;
+    if (window.WhitenedError(state, id, z->second) <= gate_sigma_) {
+      ++counts_.landmark_returns;
+    } else if (!seen_live) {
+      window.DropLandmark(id);
+      ++counts_.gated;
+    }
   }
 }
 
-void LocalMap::AddKeyframeObservations(Window& window) const {
+// The live keyframes' observations of landmarks in the cost, each within the gate.
+void LocalMap::AddKeyframeObservations(Window& window) {
   for (StateId id : data_.live) {
     for (const auto& [landmark, z] : data_.keyframes.at(id).observations) {
       if (!window.HasLandmark(landmark) || window.landmark(landmark).observed_from.count(id) > 0) continue;
+      if (!(window.WhitenedError(id, landmark, z) <= gate_sigma_)) {
+        ++counts_.gated;
+        continue;
+      }
       window.AddObservation(id, landmark, z);
     }
   }
@@ -236,7 +273,8 @@ void LogLocalMapCounts(const LocalMap& map) {
   const LocalMapCounts& c = map.counts();
   LOG(INFO) << "local map: " << c.keyframes << " keyframes, " << c.dropped << " frames dropped, " << c.parked
             << " keyframes parked, " << c.unparked << " brought back, " << c.landmark_returns
-            << " parked landmarks observed again; at most " << c.most_states << " states in the cost";
+            << " parked landmarks observed again, " << c.gated << " observations beyond the gate not added again; at most "
+            << c.most_states << " states in the cost";
 }
 
 }  // namespace vio

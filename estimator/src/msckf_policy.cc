@@ -35,10 +35,16 @@ MsckfPolicy::MsckfPolicy(const EstimatorOptions& options, std::optional<int> gn_
   CHECK_GE(options_.policy.window_size, 2) << "the MSCKF needs a window of at least 2 states";
 }
 
-PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Window& window) {
+PolicyTiming MsckfPolicy::Update(const StereoFrame& given, StateId new_state, Window& window) {
   PolicyTiming timing;
   auto start = std::chrono::steady_clock::now();
-  if (local_map_.enabled()) ForgetObservationsOf(local_map_.Prepare(frame, new_state, window));
+  StereoFrame frame = given;
+  if (local_map_.enabled()) {
+    std::vector<StateId> parked;
+    frame = local_map_.Prepare(given, new_state, window, &parked);
+    ForgetObservationsOf(parked);
+    AttachTracksOfLandmarksInTheCost(window);
+  }
   for (const StereoObservation& obs : frame.observations) {
     if (window.HasLandmark(obs.landmark)) {  // a kept landmark: the observation re-attaches to it
       window.AddObservation(new_state, obs.landmark, obs.z_px);
@@ -90,6 +96,23 @@ void MsckfPolicy::LeaveWindow(const std::vector<StateId>& leaving, const std::ve
   marginalized.insert(marginalized.end(), retired.begin(), retired.end());
   window.Marginalize(leaving, marginalized);
   ForgetObservationsOf(leaving);
+}
+
+// Local map: a pending track whose landmark the map brought back into the cost gives it its
+// views (those within the reprojection gate) and ends.
+void MsckfPolicy::AttachTracksOfLandmarksInTheCost(Window& window) {
+  for (auto it = tracks_.begin(); it != tracks_.end();) {
+    if (!window.HasLandmark(it->first)) {
+      ++it;
+      continue;
+    }
+    for (const auto& [state, z] : it->second) {
+      if (window.WhitenedError(state, it->first, z) <= options_.model.max_whitened_residual) {
+        window.AddObservation(state, it->first, z);
+      }
+    }
+    it = tracks_.erase(it);
+  }
 }
 
 // Local map: the tracks seen from a keyframe about to leave the recent window

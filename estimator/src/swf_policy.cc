@@ -20,9 +20,10 @@ PolicyTiming SwfPolicy::Update(const StereoFrame& frame, StateId new_state, Wind
 
 PolicyTiming SwfPolicy::UpdateWithLocalMap(const StereoFrame& frame, StateId new_state, Window& window) {
   auto start = std::chrono::steady_clock::now();
-  local_map_.Prepare(frame, new_state, window);
+  std::vector<StateId> parked;
+  const StereoFrame gated = local_map_.Prepare(frame, new_state, window, &parked);
   const double prepare_ms = MillisecondsSince(start);
-  PolicyTiming timing = AddFrameAndSolve(frame, new_state, options_, window);
+  PolicyTiming timing = AddFrameAndSolve(gated, new_state, options_, window);
   timing.build_ms += prepare_ms;
   start = std::chrono::steady_clock::now();
   local_map_.Slide(window);

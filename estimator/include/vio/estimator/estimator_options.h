@@ -116,6 +116,7 @@ struct PersistentOptions {
 struct LocalMapOptions {
   int local_map_keyframes = 0;     ///< K: keyframes solved with the recent window [count]; 0 = off
   double local_map_overlap = 0.7;  ///< new keyframe below this landmark fraction shared with the reference keyframe []
+  double local_map_max_link_s = 3.0;  ///< longest IMU factor between keyframes, else the frame is one [s]
 
   template <class V>
   void Visit(V& v) {
@@ -128,6 +129,10 @@ struct LocalMapOptions {
       "local map: a frame becomes a keyframe when less than this fraction of its landmarks is seen by its "
       "reference keyframe (the keyframe sharing most of them) []",
       Between(0, 1));
+    v("local_map_max_link_s", local_map_max_link_s,
+      "local map: a frame leaving the window joins the map as a keyframe when the IMU factor from the last keyframe "
+      "would span more than this (a camera circling a mapped place adds no keyframes by overlap) [s]",
+      Positive());
   }
 };
 

@@ -9,12 +9,15 @@
 // own). A frame is a keyframe when less than `local_map_overlap` of its
 // landmarks is seen by its reference keyframe, the keyframe (in the map or in
 // the recent window) sharing most landmarks with it (IsKeyframe): a place
-// already in the map makes no new keyframes, so the map grows with the
-// explored space, not with the run's length. When a state leaves the recent
+// already in the map makes no new keyframes by this rule. When a state leaves the recent
 // window it joins the map if it is a keyframe and is dropped otherwise
 // (Window::DropState: its observations go, its two IMU factors merge), so
 // consecutive keyframes stay tied by IMU preintegration over the frames
-// between them.
+// between them; a state leaving the recent window also joins the map when the
+// IMU factor from the last keyframe would otherwise span more than
+// `local_map_max_link_s` (a camera circling a mapped place makes no keyframes
+// by overlap, and one IMU factor over minutes would cost more every frame):
+// the map's memory grows with the run's length, its cost per frame does not.
 //
 // The active set of a solve (SelectActiveSet): the recent window, the newest
 // map keyframe (it carries the IMU factor into the window) and the keyframes
@@ -24,7 +27,7 @@
 // landmarks with the active states. Every other keyframe, and every landmark
 // no active state sees, is parked outside the cost (Window::RemoveState,
 // DropLandmark) with its last estimate, and comes back when the active set
-// needs it: the cost per frame is bounded by the window, 3K keyframes and
+// needs it: the cost per frame is bounded by the window, 4K keyframes and
 // their landmarks, whatever the run's length.
 //
 // Data (LocalMapData) and functions over it; LocalMap applies them to a
@@ -84,18 +87,26 @@ struct LocalMapCounts {
   int parked = 0;            ///< keyframes parked outside the cost
   int unparked = 0;          ///< keyframes brought back
   int landmark_returns = 0;  ///< parked landmarks brought back because a new frame observes them
+  int gated = 0;             ///< observations the map did not add again: predicted beyond the gate
   int most_states = 0;       ///< largest number of states in the cost [count]
 };
 
 class LocalMap {
  public:
-  explicit LocalMap(const EstimatorOptions& options) : options_(options.local_map), window_size_(options.policy.window_size) {}
+  explicit LocalMap(const EstimatorOptions& options)
+      : options_(options.local_map),
+        window_size_(options.policy.window_size),
+        gate_sigma_(options.model.max_whitened_residual),
+        max_link_ns_(SecondsToNanos(options.local_map.local_map_max_link_s)) {}
   bool enabled() const { return options_.local_map_keyframes > 0; }
 
   /// Before the frame's observations enter: records the frame (keyframe or
   /// not), applies the active set (including the frame's landmarks) and brings
-  /// back the parked landmarks the frame observes. Returns the parked keyframes.
-  std::vector<StateId> Prepare(const StereoFrame& frame, StateId state, Window& window);
+  /// back the parked landmarks the frame observes. Returns the frame without
+  /// its observations of returned landmarks predicted beyond the gate
+  /// (max_whitened_residual, as the estimator gates the others); `parked`
+  /// gets the keyframes parked.
+  StereoFrame Prepare(const StereoFrame& frame, StateId state, Window& window, std::vector<StateId>* parked);
   /// The recent state the next Slide moves out of the recent window, when it is a keyframe.
   std::optional<StateId> KeyframeLeaving() const;
   /// After the solve: the oldest state beyond the recent window joins the map
@@ -105,17 +116,19 @@ class LocalMap {
   const LocalMapCounts& counts() const { return counts_; }
 
  private:
-  void Apply(const ActiveSet& set, const std::vector<LandmarkId>& frame_landmarks, Window& window,
+  void Apply(const ActiveSet& set, const StereoFrame& frame, StateId state, Window& window,
              std::vector<StateId>* parked);
   void Park(StateId id, Window& window);
   void Unpark(StateId id, Window& window);
   void LinkChain(Window& window) const;
-  void SyncLandmarks(const ActiveSet& set, const std::vector<LandmarkId>& frame_landmarks, Window& window);
-  void AddKeyframeObservations(Window& window) const;
+  void SyncLandmarks(const ActiveSet& set, const StereoFrame& frame, StateId state, Window& window);
+  void AddKeyframeObservations(Window& window);
   void JoinMap(StateId id, Window& window);
 
   LocalMapOptions options_;
   int window_size_;
+  double gate_sigma_;  ///< observations the map adds again must be predicted this well [sigma]
+  Timestamp max_link_ns_;  ///< longest IMU factor between keyframes
   LocalMapData data_;
   LocalMapCounts counts_;
 };

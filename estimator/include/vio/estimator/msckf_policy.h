@@ -88,6 +88,7 @@ class MsckfPolicy final : public Policy {
   void LeaveWindow(const std::vector<StateId>& leaving, const std::vector<LandmarkId>& added,
                    const std::vector<LandmarkId>& retired, Window& window);
   std::vector<TrackUpdate> TracksSeenFrom(StateId keyframe);
+  void AttachTracksOfLandmarksInTheCost(Window& window);
   std::optional<int> GaussNewtonSteps(const StereoFrame& frame);
 
   EstimatorOptions options_;
