@@ -30,14 +30,21 @@ bool IsLeaving(StateId state, const std::vector<StateId>& leaving) {
 }  // namespace
 
 MsckfPolicy::MsckfPolicy(const EstimatorOptions& options, std::optional<int> gn_steps)
-    : options_(options), gn_steps_(gn_steps), persistent_(options.persistent) {
+    : options_(options), gn_steps_(gn_steps), persistent_(options.persistent), local_map_(options) {
   CHECK(!gn_steps_ || *gn_steps_ >= 1);
   CHECK_GE(options_.policy.window_size, 2) << "the MSCKF needs a window of at least 2 states";
 }
 
-PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Window& window) {
+PolicyTiming MsckfPolicy::Update(const StereoFrame& given, StateId new_state, Window& window) {
   PolicyTiming timing;
   auto start = std::chrono::steady_clock::now();
+  StereoFrame frame = given;
+  if (local_map_.enabled()) {
+    std::vector<StateId> parked;
+    frame = local_map_.Prepare(given, new_state, window, &parked);
+    ForgetObservationsOf(parked);
+    AttachTracksOfLandmarksInTheCost(window);
+  }
   for (const StereoObservation& obs : frame.observations) {
     if (window.HasLandmark(obs.landmark)) {  // a kept landmark: the observation re-attaches to it
       window.AddObservation(new_state, obs.landmark, obs.z_px);
@@ -46,10 +53,13 @@ PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
     }
   }
   persistent_.Observe(frame);
-  const std::vector<StateId> leaving = LeavingStates(window);
+  const std::vector<StateId> leaving = local_map_.enabled() ? std::vector<StateId>{} : LeavingStates(window);
   std::vector<LandmarkId> retired;
   std::vector<TrackUpdate> updates = PromoteTracks(frame, leaving, window, retired);
   for (TrackUpdate& update : MatureTracks(frame, leaving)) updates.push_back(std::move(update));
+  if (const std::optional<StateId> keyframe = local_map_.KeyframeLeaving()) {
+    for (TrackUpdate& update : TracksSeenFrom(*keyframe)) updates.push_back(std::move(update));
+  }
   const std::vector<LandmarkId> added = AddTriangulated(updates, window);
   window.RefreshImuFactors(options_.model.reintegrate_bias_threshold);
   timing.build_ms = MillisecondsSince(start);
@@ -64,6 +74,21 @@ PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
           << report.initial_cost << " -> " << report.final_cost;
 
   start = std::chrono::steady_clock::now();
+  LeaveWindow(leaving, added, retired, window);
+  timing.marginalize_ms = MillisecondsSince(start);
+  return timing;
+}
+
+// The MSCKF marginalizes the leaving states and the landmarks it used (kept
+// ones stay, retired ones go). With the local map nothing is marginalized:
+// the used landmarks join the cost, the oldest recent state joins the map or
+// is dropped.
+void MsckfPolicy::LeaveWindow(const std::vector<StateId>& leaving, const std::vector<LandmarkId>& added,
+                              const std::vector<LandmarkId>& retired, Window& window) {
+  if (local_map_.enabled()) {
+    ForgetObservationsOf(local_map_.Slide(window));
+    return;
+  }
   std::vector<LandmarkId> marginalized;
   for (LandmarkId id : added) {
     if (!persistent_.IsKept(id)) marginalized.push_back(id);
@@ -71,8 +96,41 @@ PolicyTiming MsckfPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
   marginalized.insert(marginalized.end(), retired.begin(), retired.end());
   window.Marginalize(leaving, marginalized);
   ForgetObservationsOf(leaving);
-  timing.marginalize_ms = MillisecondsSince(start);
-  return timing;
+}
+
+// Local map: a pending track whose landmark the map brought back into the cost gives it its
+// views (those within the reprojection gate) and ends.
+void MsckfPolicy::AttachTracksOfLandmarksInTheCost(Window& window) {
+  for (auto it = tracks_.begin(); it != tracks_.end();) {
+    if (!window.HasLandmark(it->first)) {
+      ++it;
+      continue;
+    }
+    for (const auto& [state, z] : it->second) {
+      if (window.WhitenedError(state, it->first, z) <= options_.model.max_whitened_residual) {
+        window.AddObservation(state, it->first, z);
+      }
+    }
+    it = tracks_.erase(it);
+  }
+}
+
+// Local map: the tracks seen from a keyframe about to leave the recent window
+// are used whole (they restart): its landmarks join the map with it.
+std::vector<MsckfPolicy::TrackUpdate> MsckfPolicy::TracksSeenFrom(StateId keyframe) {
+  std::vector<TrackUpdate> updates;
+  for (auto it = tracks_.begin(); it != tracks_.end();) {
+    const std::vector<Observation>& observations = it->second;
+    const bool seen = std::any_of(observations.begin(), observations.end(),
+                                  [&](const Observation& o) { return o.first == keyframe; });
+    if (!seen || static_cast<int>(observations.size()) < options_.msckf.msckf_min_track_length) {
+      ++it;
+      continue;
+    }
+    updates.push_back({it->first, std::move(it->second)});
+    it = tracks_.erase(it);
+  }
+  return updates;
 }
 
 bool MsckfPolicy::Finish(Window& /*window*/) {
@@ -80,6 +138,7 @@ bool MsckfPolicy::Finish(Window& /*window*/) {
             << " rejected by triangulation (" << counts_.rejected_views << " views), " << counts_.too_short
             << " too short; " << counts_.forgotten_views << " views left with their state unused";
   LogPersistentCounts(persistent_);
+  LogLocalMapCounts(local_map_);
   return false;
 }
 

@@ -29,9 +29,15 @@ bool EvaluatesFinitely(const ceres::Problem& problem, ceres::ResidualBlockId id)
   std::vector<double> residuals(static_cast<size_t>(f->num_residuals()));
   std::vector<std::vector<double>> jacobian_storage;
   std::vector<double*> jacobians;
-  for (const int size : f->parameter_block_sizes()) {
-    if (residual_only) break;
-    jacobian_storage.emplace_back(static_cast<size_t>(size * f->num_residuals()));
+  std::vector<double*> blocks;
+  problem.GetParameterBlocksForResidualBlock(id, &blocks);
+  for (size_t i = 0; i < blocks.size() && !residual_only; ++i) {
+    // Ceres gives no Jacobian on a constant block (a fixed keyframe of the local map).
+    if (problem.IsParameterBlockConstant(blocks[i])) {
+      jacobians.push_back(nullptr);
+      continue;
+    }
+    jacobian_storage.emplace_back(static_cast<size_t>(f->parameter_block_sizes()[i] * f->num_residuals()));
     jacobians.push_back(jacobian_storage.back().data());
   }
   double cost = 0.0;

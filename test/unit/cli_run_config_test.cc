@@ -59,5 +59,27 @@ TEST(RunConfig, PersistentLandmarksAreCheckedAgainstThePolicy) {
   }
 }
 
+// The local map is an option of swf and msckf alone, with a window of at least 2,
+// and not together with long-lived landmarks: each refusal names the option.
+TEST(RunConfig, LocalMapIsCheckedAgainstThePolicy) {
+  const std::string dir = test::MakeTempDir("run_config");
+  const std::string path = dir + "/local_map.yaml";
+  const auto refused = [&](const std::string& yaml, const std::string& expected) {
+    std::ofstream(path) << yaml;
+    try {
+      LoadRunConfig(path);
+      ADD_FAILURE() << "accepted: " << yaml;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("--local_map_keyframes=8"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refused("policy:\n  policy: ekf\nlocal_map:\n  local_map_keyframes: 8\n", "ekf");
+  refused("policy:\n  window_size: 1\nlocal_map:\n  local_map_keyframes: 8\n", "window_size");
+  refused("persistent:\n  persistent_landmarks: 5\nlocal_map:\n  local_map_keyframes: 8\n", "persistent_landmarks");
+  std::ofstream(path) << "policy:\n  policy: msckf\nlocal_map:\n  local_map_keyframes: 8\n";
+  EXPECT_EQ(LoadRunConfig(path).estimator.local_map.local_map_keyframes, 8);
+}
+
 }  // namespace
 }  // namespace vio::tools

@@ -68,6 +68,26 @@ TEST(SweepPlan, RunArgumentsSetDatasetFolderPolicyWindowThenTheExtraFlags) {
   EXPECT_THROW(RunArguments(request, run), std::invalid_argument);
 }
 
+// policy:window:K runs: the local map's keyframes are a run's own flag, its folder and label say them.
+TEST(SweepPlan, LocalMapRunsPassTheirKeyframes) {
+  SweepRequest request = TwoDatasetRequest();
+  request.combinations = {{"swf", 10, 0}, {"swf", 10, 8}, {"msckf", 10, 8}};
+  const std::vector<SweepRun> plan = PlanSweep(request);
+  ASSERT_EQ(plan.size(), 6u);
+  EXPECT_EQ(plan[0].Label(), "V2_01 swf_10");
+  EXPECT_EQ(plan[1].Label(), "V2_01 swf+map8_10");
+  EXPECT_EQ(plan[1].run_dir, request.output_dir + "/runs/V2_01/swf+map8_10");
+  EXPECT_THAT(RunArguments(request, plan[2]),
+              ElementsAre("/opt/vio/bin/vio", "run", "--dataset=" + plan[2].dataset_dir,
+                          "--output_dir=" + plan[2].run_dir, "--policy=msckf", "--window_size=10",
+                          "--local_map_keyframes=8"));
+  request.run_flags = {"--local_map_keyframes=4"};
+  EXPECT_NO_THROW(RunArguments(request, plan[0]));  // forwarded to the runs without their own
+  EXPECT_THROW(RunArguments(request, plan[1]), std::invalid_argument);
+  request.combinations.push_back({"swf", 10, 8});
+  EXPECT_THROW(PlanSweep(request), std::invalid_argument);
+}
+
 TEST(SweepPlan, JobLineSkipsFinishedRunsAndWritesTheMarkerOnlyWithASummary) {
   const SweepRequest request = TwoDatasetRequest();
   const SweepRun run = PlanSweep(request)[0];

@@ -17,7 +17,8 @@ DEFINE_string(policies, "swf", "estimator policies to sweep, comma separated (pa
 DEFINE_string(window_sizes, "10", "window sizes to sweep, comma separated (passed as --window_size) [frames]");
 DEFINE_string(runs, "",
               "explicit policy:window pairs instead of --policies x --window_sizes, e.g. "
-              "swf:5,swf:10,msckf:10,ekf:1,batch:10");
+              "swf:5,swf:10,msckf:10,ekf:1,batch:10; policy:window:K also sets --local_map_keyframes=K "
+              "(swf:10:8 runs as swf+map8_10)");
 DEFINE_int32(seeds, 0,
              "Monte Carlo: simulate this many datasets that differ only in their noise (vio simulate "
              "--noise_seed=1..N with --simulate_flags) instead of --datasets; every run writes its covariance and "
@@ -66,17 +67,24 @@ std::vector<int> ParseWindowSizes(const std::string& text) {
   return sizes;
 }
 
-// "swf:10,msckf:10" -> {(swf, 10), (msckf, 10)}.
-std::vector<std::pair<std::string, int>> ParseRuns(const std::string& text) {
-  std::vector<std::pair<std::string, int>> runs;
+// "swf:10,msckf:10:8" -> {(swf, 10, 0), (msckf, 10, 8)}: policy:window[:local map keyframes].
+std::vector<SweepCombination> ParseRuns(const std::string& text) {
+  std::vector<SweepCombination> runs;
   for (const std::string& item : SplitList(text)) {
     const size_t colon = item.find(':');
     if (colon == std::string::npos || colon == 0) {
       throw std::invalid_argument("--runs: '" + item + "' is not policy:window");
     }
-    const std::vector<int> window = ParseWindowSizes(item.substr(colon + 1));
+    const size_t second = item.find(':', colon + 1);
+    const std::vector<int> window = ParseWindowSizes(item.substr(colon + 1, second - colon - 1));
     if (window.size() != 1) throw std::invalid_argument("--runs: '" + item + "' is not policy:window");
-    runs.emplace_back(item.substr(0, colon), window.front());
+    int keyframes = 0;
+    if (second != std::string::npos) {
+      const std::vector<int> k = ParseWindowSizes(item.substr(second + 1));
+      if (k.size() != 1) throw std::invalid_argument("--runs: '" + item + "' is not policy:window:K");
+      keyframes = k.front();
+    }
+    runs.push_back({item.substr(0, colon), window.front(), keyframes});
   }
   return runs;
 }

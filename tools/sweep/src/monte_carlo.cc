@@ -101,10 +101,10 @@ std::vector<MonteCarloSummary> SummarizeMonteCarlo(const std::vector<SweepResult
   std::vector<MonteCarloSummary> summaries;
   std::map<std::pair<std::string, int>, std::vector<const SweepResult*>> groups;
   for (const SweepResult& r : results) {
-    const auto key = std::make_pair(r.run.policy, r.run.window_size);
+    const auto key = std::make_pair(r.run.PolicyLabel(), r.run.window_size);
     if (!groups.count(key)) {
       MonteCarloSummary summary;
-      summary.policy = r.run.policy;
+      summary.policy = r.run.PolicyLabel();
       summary.window_size = r.run.window_size;
       summaries.push_back(summary);
     }

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <tuple>
 #include <stdexcept>
 
 #include "vio/sweep/sweep.h"
@@ -76,35 +77,42 @@ std::string FlagName(const std::string& flag) {
 
 }  // namespace
 
-std::string SweepRun::Label() const { return dataset_name + " " + policy + "_" + std::to_string(window_size); }
+std::string SweepRun::PolicyLabel() const {
+  return local_map_keyframes > 0 ? policy + "+map" + std::to_string(local_map_keyframes) : policy;
+}
+
+std::string SweepRun::Label() const { return dataset_name + " " + PolicyLabel() + "_" + std::to_string(window_size); }
 
 std::vector<SweepRun> PlanSweep(const SweepRequest& request) {
   CheckRequest(request);
   const std::string runs_dir = AbsolutePath(request.output_dir) + "/runs";
-  std::vector<std::pair<std::string, int>> combinations = request.combinations;
+  std::vector<SweepCombination> combinations = request.combinations;
   if (combinations.empty()) {
     for (const std::string& policy : request.policies) {
-      for (int window : request.window_sizes) combinations.emplace_back(policy, window);
+      for (int window : request.window_sizes) combinations.push_back({policy, window, 0});
     }
   }
-  std::set<std::pair<std::string, int>> listed;
-  for (const auto& [policy, window] : combinations) {
+  std::set<std::tuple<std::string, int, int>> listed;
+  for (const auto& [policy, window, keyframes] : combinations) {
     CheckName("policy", policy);
     if (window < 1) throw std::invalid_argument("window size " + std::to_string(window) + " < 1");
-    if (!listed.emplace(policy, window).second) {
+    if (keyframes < 0) throw std::invalid_argument("local map keyframes " + std::to_string(keyframes) + " < 0");
+    if (!listed.emplace(policy, window, keyframes).second) {
       throw std::invalid_argument("run " + policy + ":" + std::to_string(window) +
+                                  (keyframes > 0 ? ":" + std::to_string(keyframes) : "") +
                                   " is listed twice (each run has one folder)");
     }
   }
   std::vector<SweepRun> plan;
   for (const auto& [name, dir] : NamedDatasets(request.datasets)) {
-    for (const auto& [policy, window] : combinations) {
+    for (const auto& [policy, window, keyframes] : combinations) {
       SweepRun run;
       run.dataset_name = name;
       run.dataset_dir = dir;
       run.policy = policy;
       run.window_size = window;
-      run.run_dir = runs_dir + "/" + name + "/" + policy + "_" + std::to_string(window);
+      run.local_map_keyframes = keyframes;
+      run.run_dir = runs_dir + "/" + name + "/" + run.PolicyLabel() + "_" + std::to_string(window);
       plan.push_back(run);
     }
   }
@@ -118,10 +126,15 @@ std::vector<std::string> RunArguments(const SweepRequest& request, const SweepRu
                                    "--output_dir=" + run.run_dir,
                                    "--policy=" + run.policy,
                                    "--window_size=" + std::to_string(run.window_size)};
+  if (run.local_map_keyframes > 0) argv.push_back("--local_map_keyframes=" + std::to_string(run.local_map_keyframes));
   if (!request.config_path.empty()) argv.push_back("--config=" + AbsolutePath(request.config_path));
   for (const std::string& flag : request.run_flags) {
     if (SweepOwnedFlags().count(FlagName(flag)) > 0) {
       throw std::invalid_argument("run flag '" + flag + "' is set by the sweep itself for every run");
+    }
+    if (run.local_map_keyframes > 0 && FlagName(flag) == "local_map_keyframes") {
+      throw std::invalid_argument("run flag '" + flag + "' and the run " + run.Label() +
+                                  " both set the local map's keyframes");
     }
     argv.push_back(flag);
   }

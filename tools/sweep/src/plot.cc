@@ -67,7 +67,7 @@ int WriteDatasetPlotData(const std::vector<const SweepResult*>& runs, const std:
     const std::string trajectory = r->run.run_dir + "/trajectory.txt";
     if (r->status == "failed" || r->status == "missing" || !fs::exists(trajectory)) continue;
     try {
-      WriteAlignedEstimate(gt, trajectory, data_dir + "/" + r->run.policy + "_" +
+      WriteAlignedEstimate(gt, trajectory, data_dir + "/" + r->run.PolicyLabel() + "_" +
                                                std::to_string(r->run.window_size) + ".csv");
       ++written;
     } catch (const std::exception& e) {

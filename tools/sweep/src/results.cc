@@ -160,7 +160,7 @@ std::string ResultsCsv(const std::vector<SweepResult>& results) {
   for (double l : lengths) csv += ",rpe_" + Exact(l) + "m_trans_pct,rpe_" + Exact(l) + "m_rot_deg_per_m";
   csv += ",ms_per_frame,real_time_factor,peak_memory_mb,nees_pose,nees_position,nees_orientation,message,run_dir\n";
   for (const SweepResult& r : results) {
-    csv += r.run.dataset_name + "," + r.run.policy + "," + std::to_string(r.run.window_size) + "," + r.status +
+    csv += r.run.dataset_name + "," + r.run.PolicyLabel() + "," + std::to_string(r.run.window_size) + "," + r.status +
            "," + (r.exit_code >= 0 ? std::to_string(r.exit_code) : "") + "," + Exact(r.ate_rmse_m);
     for (double l : lengths) {
       const SweepRpe* rpe = RpeAt(r, l);
@@ -184,7 +184,7 @@ std::string ResultsMarkdown(const std::vector<SweepResult>& results) {
   md += " | ms/frame | x real time | peak memory [MB] |\n" + rule + "|---:|---:|---:|\n";
   auto cell = [](const std::string& text) { return text.empty() ? std::string("-") : text; };
   for (const SweepResult& r : results) {
-    md += "| " + r.run.dataset_name + " | " + r.run.policy + " | " + std::to_string(r.run.window_size) + " | " +
+    md += "| " + r.run.dataset_name + " | " + r.run.PolicyLabel() + " | " + std::to_string(r.run.window_size) + " | " +
           StatusText(r) + " | " + cell(Fixed(r.ate_rmse_m, 3));
     for (double l : lengths) {
       const SweepRpe* rpe = RpeAt(r, l);

@@ -111,6 +111,31 @@ struct PersistentOptions {
   }
 };
 
+/// The local map behind the windows swf and msckf (local_map.h): keyframes
+/// and their landmarks kept live behind the recent frames.
+struct LocalMapOptions {
+  int local_map_keyframes = 0;     ///< K: keyframes solved with the recent window [count]; 0 = off
+  double local_map_overlap = 0.7;  ///< new keyframe below this landmark fraction shared with the reference keyframe []
+  double local_map_max_link_s = 3.0;  ///< longest IMU factor between keyframes, else the frame is one [s]
+
+  template <class V>
+  void Visit(V& v) {
+    v("local_map_keyframes", local_map_keyframes,
+      "swf, msckf: a local map behind the window: frames leaving it are keyframes (kept live with their landmarks, "
+      "tied by IMU preintegration) or dropped; each solve frees the window plus the K keyframes sharing most "
+      "landmarks with it, holds their neighbours fixed and parks the rest outside the cost; 0 = off [count]",
+      Between(0, 200));
+    v("local_map_overlap", local_map_overlap,
+      "local map: a frame becomes a keyframe when less than this fraction of its landmarks is seen by its "
+      "reference keyframe (the keyframe sharing most of them) []",
+      Between(0, 1));
+    v("local_map_max_link_s", local_map_max_link_s,
+      "local map: a frame leaving the window joins the map as a keyframe when the IMU factor from the last keyframe "
+      "would span more than this (a camera circling a mapped place adds no keyframes by overlap) [s]",
+      Positive());
+  }
+};
+
 /// Full batch: no marginalization; old states frozen while running, all
 /// solved together at the end.
 struct BatchOptions {
@@ -257,6 +282,7 @@ struct EstimatorOptions {
   PolicyOptions policy;
   MsckfOptions msckf;
   PersistentOptions persistent;
+  LocalMapOptions local_map;
   BatchOptions batch;
   SolverOptions solver;
   ModelOptions model;

@@ -29,10 +29,17 @@
 // its landmark is triangulated from the whole track, added, and stays a
 // parameter (OpenVINS' "SLAM features"); its later observations are added to
 // the window directly, its views from leaving states go into the prior.
+//
+// With local_map_keyframes > 0 (local_map.h) nothing is marginalized: used
+// landmarks stay in the cost, the state leaving the recent window joins the
+// local map (a keyframe: the tracks seen from it are used whole first) or is
+// dropped, and map landmarks a frame observes again take its observation
+// directly, as kept landmarks do.
 #include <map>
 #include <optional>
 #include <vector>
 
+#include "vio/estimator/local_map.h"
 #include "vio/estimator/persistent_landmarks.h"
 #include "vio/estimator/policy.h"
 #include "vio/estimator/triangulation.h"
@@ -59,6 +66,7 @@ class MsckfPolicy final : public Policy {
   bool Finish(Window& /*window*/) override;
   const MsckfCounts& counts() const { return counts_; }
   const PersistentLandmarks& persistent() const { return persistent_; }
+  const LocalMap& local_map() const { return local_map_; }
 
  private:
   using Observation = std::pair<StateId, Eigen::Vector3d>;
@@ -77,6 +85,10 @@ class MsckfPolicy final : public Policy {
   std::vector<LandmarkId> AddTriangulated(const std::vector<TrackUpdate>& updates, Window& window);
   double ReprojectionGate(const std::vector<TriangulationResult>& results) const;
   void ForgetObservationsOf(const std::vector<StateId>& leaving);
+  void LeaveWindow(const std::vector<StateId>& leaving, const std::vector<LandmarkId>& added,
+                   const std::vector<LandmarkId>& retired, Window& window);
+  std::vector<TrackUpdate> TracksSeenFrom(StateId keyframe);
+  void AttachTracksOfLandmarksInTheCost(Window& window);
   std::optional<int> GaussNewtonSteps(const StereoFrame& frame);
 
   EstimatorOptions options_;
@@ -84,6 +96,7 @@ class MsckfPolicy final : public Policy {
   std::map<LandmarkId, std::vector<Observation>> tracks_;  ///< unused observations, oldest first
   MsckfCounts counts_;
   PersistentLandmarks persistent_;  ///< long-lived landmarks (off unless persistent_landmarks > 0)
+  LocalMap local_map_;              ///< off unless local_map_keyframes > 0
   int frames_without_observations_ = 0;  ///< the current run of empty frames (tracking loss)
   int reanchor_frames_ = 0;              ///< frames left solving to convergence after a long loss
 };

@@ -142,6 +142,13 @@ class Window {
   void DropState(StateId id);
   /// True when a marginalization prior involves the state.
   bool IsInPrior(StateId id) const;
+  /// Removes a state with every factor on it (observations, IMU factors,
+  /// priors on it alone) without keeping information and without merging IMU
+  /// factors: a keyframe the local map parks outside the cost. Landmarks it
+  /// leaves unobserved stay. It must not share a prior with another block.
+  void RemoveState(StateId id);
+  /// Holds a state's speed/bias block fixed in Solve (or frees it); the pose as it is.
+  void SetSpeedBiasConstant(StateId id, bool constant);
   /// What was removed since the last ClearRemovals (the estimator clears it
   /// every frame; the structural policy tests read it).
   const Removals& removals() const { return removals_; }
@@ -155,6 +162,10 @@ class Window {
   bool HasState(StateId id) const { return states_.count(id) > 0; }
   bool HasLandmark(LandmarkId id) const { return landmarks_.count(id) > 0; }
   const Landmark& landmark(LandmarkId id) const;
+  /// The state's observations: landmark and z = (u_L, u_R, v) [px], by landmark id.
+  std::vector<std::pair<LandmarkId, Eigen::Vector3d>> ObservationsOf(StateId state) const;
+  /// The IMU factor into state `to`: its first state and preintegration; null without one.
+  const ImuPreintegration* ImuFactorInto(StateId to, StateId* from) const;
   /// Whitened stereo reprojection error of one observation [sigma].
   double ObservationError(StateId state, LandmarkId landmark) const;
   /// Whitened stereo reprojection error of a measurement z = (u_L, u_R, v) of

@@ -30,14 +30,20 @@
 
 namespace vio::tools {
 
+/// One explicit run of a sweep: policy, window and local map.
+struct SweepCombination {
+  std::string policy;
+  int window_size = 0;
+  int local_map_keyframes = 0;  ///< passed as --local_map_keyframes when > 0
+};
+
 /// What to sweep and how.
 struct SweepRequest {
   std::vector<std::string> datasets;  ///< EuRoC ASL folders (holding mav0/)
   std::vector<std::string> policies;  ///< passed as --policy
   std::vector<int> window_sizes;      ///< passed as --window_size [frames]
-  /// Explicit (policy, window) pairs; when not empty they replace the
-  /// policies x window_sizes product.
-  std::vector<std::pair<std::string, int>> combinations;
+  /// Explicit runs; when not empty they replace the policies x window_sizes product.
+  std::vector<SweepCombination> combinations;
   std::string output_dir;             ///< the sweep's folder (created when missing)
   std::string vio_binary;             ///< the `vio` executable every run uses
   std::string config_path;            ///< --config of every run; empty = none
@@ -53,8 +59,11 @@ struct SweepRun {
   std::string dataset_dir;   ///< absolute
   std::string policy;
   int window_size = 0;
-  std::string run_dir;  ///< <output_dir>/runs/<dataset_name>/<policy>_<window_size>
-  std::string Label() const;  ///< "<dataset_name> <policy>_<window_size>"
+  int local_map_keyframes = 0;  ///< --local_map_keyframes of the run; 0 = not set by the sweep
+  std::string run_dir;  ///< <output_dir>/runs/<dataset_name>/<PolicyLabel>_<window_size>
+  std::string Label() const;  ///< "<dataset_name> <PolicyLabel>_<window_size>"
+  /// The policy, with "+map<K>" when the run has a local map of K keyframes.
+  std::string PolicyLabel() const;
 };
 
 /// RPE over one sub-trajectory length, as summary.json reports it.

@@ -1,0 +1,280 @@
+#include "vio/estimator/local_map.h"
+
+#include <algorithm>
+#include <iterator>
+#include <tuple>
+
+#include <glog/logging.h>
+
+namespace vio {
+namespace {
+
+// Keyframes by shared landmarks, most first; newer first among equals.
+std::vector<StateId> MostShared(const std::map<StateId, int>& shared) {
+  std::vector<std::pair<int, StateId>> ranked;
+  for (const auto& [id, count] : shared) ranked.emplace_back(count, id);
+  std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
+    return std::make_tuple(-a.first, -a.second.value) < std::make_tuple(-b.first, -b.second.value);
+  });
+  std::vector<StateId> out;
+  for (const auto& [count, id] : ranked) out.push_back(id);
+  return out;
+}
+
+// The map keyframes before and after `id` in the chain (none at its ends).
+std::vector<StateId> ChainNeighbours(const LocalMapData& map, StateId id) {
+  std::vector<StateId> out;
+  auto it = map.keyframes.find(id);
+  if (it == map.keyframes.end()) return out;
+  if (it != map.keyframes.begin()) out.push_back(std::prev(it)->first);
+  if (std::next(it) != map.keyframes.end()) out.push_back(std::next(it)->first);
+  return out;
+}
+
+std::set<LandmarkId> RecentLandmarks(const LocalMapData& map) {
+  std::set<LandmarkId> out;
+  for (const auto& [id, landmarks] : map.recent) out.insert(landmarks.begin(), landmarks.end());
+  return out;
+}
+
+}  // namespace
+
+bool IsKeyframe(const std::vector<LandmarkId>& frame_landmarks, const LocalMapData& map, double overlap) {
+  if (map.keyframes.empty() && map.recent_keyframes.empty()) return true;
+  if (frame_landmarks.empty()) return false;
+  const std::set<LandmarkId> seen(frame_landmarks.begin(), frame_landmarks.end());
+  int best = 0;
+  for (const auto& [id, count] : SharedLandmarks(map, seen)) best = std::max(best, count);
+  for (StateId id : map.recent_keyframes) {
+    const std::vector<LandmarkId>& landmarks = map.recent.at(id);
+    const int count = static_cast<int>(
+        std::count_if(landmarks.begin(), landmarks.end(), [&](LandmarkId l) { return seen.count(l) > 0; }));
+    best = std::max(best, count);
+  }
+  return best < overlap * static_cast<double>(seen.size());
+}
+
+std::map<StateId, int> SharedLandmarks(const LocalMapData& map, const std::set<LandmarkId>& landmarks) {
+  std::map<StateId, int> shared;
+  for (LandmarkId id : landmarks) {
+    auto it = map.landmarks.find(id);
+    if (it == map.landmarks.end()) continue;
+    for (StateId keyframe : it->second.keyframes) ++shared[keyframe];
+  }
+  return shared;
+}
+
+ActiveSet SelectActiveSet(const LocalMapData& map, int keyframes) {
+  ActiveSet set;
+  if (map.keyframes.empty() || keyframes <= 0) return set;
+  set.active.insert(map.keyframes.rbegin()->first);
+  std::set<LandmarkId> landmarks = RecentLandmarks(map);
+  for (StateId id : MostShared(SharedLandmarks(map, landmarks))) {
+    if (static_cast<int>(set.active.size()) >= keyframes) break;
+    set.active.insert(id);
+  }
+  for (StateId id : set.active) {
+    for (StateId neighbour : ChainNeighbours(map, id)) {
+      if (set.active.count(neighbour) == 0) set.fixed.insert(neighbour);
+    }
+    for (const auto& [landmark, z] : map.keyframes.at(id).observations) landmarks.insert(landmark);
+  }
+  int covisible = 0;
+  for (StateId id : MostShared(SharedLandmarks(map, landmarks))) {
+    if (covisible >= keyframes) break;
+    if (set.active.count(id) > 0) continue;
+    set.fixed.insert(id);
+    ++covisible;
+  }
+  return set;
+}
+
+StereoFrame LocalMap::Prepare(const StereoFrame& frame, StateId state, Window& window, std::vector<StateId>* parked) {
+  std::vector<LandmarkId> landmarks;
+  std::set<LandmarkId> in_cost;  // gated by the estimator already
+  for (const StereoObservation& obs : frame.observations) {
+    landmarks.push_back(obs.landmark);
+    if (window.HasLandmark(obs.landmark)) in_cost.insert(obs.landmark);
+  }
+  if (IsKeyframe(landmarks, data_, options_.local_map_overlap)) data_.recent_keyframes.insert(state);
+  data_.recent[state] = landmarks;
+  Apply(SelectActiveSet(data_, options_.local_map_keyframes), frame, state, window, parked);
+  StereoFrame gated = frame;
+  gated.observations.clear();
+  for (const StereoObservation& obs : frame.observations) {
+    const bool returned = window.HasLandmark(obs.landmark) && in_cost.count(obs.landmark) == 0;
+    if (returned && !(window.WhitenedError(state, obs.landmark, obs.z_px) <= gate_sigma_)) {
+      ++counts_.gated;
+      continue;
+    }
+    gated.observations.push_back(obs);
+  }
+  return gated;
+}
+
+std::optional<StateId> LocalMap::KeyframeLeaving() const {
+  if (static_cast<int>(data_.recent.size()) <= window_size_) return std::nullopt;
+  const StateId oldest = data_.recent.begin()->first;
+  if (data_.recent_keyframes.count(oldest) == 0) return std::nullopt;
+  return oldest;
+}
+
+std::vector<StateId> LocalMap::Slide(Window& window) {
+  std::vector<StateId> dropped;
+  if (static_cast<int>(data_.recent.size()) > window_size_) {
+    const StateId oldest = data_.recent.begin()->first;
+    const bool long_link = !data_.keyframes.empty() &&
+                           window.state(std::next(data_.recent.begin())->first).t_ns -
+                                   data_.keyframes.rbegin()->second.state.t_ns > max_link_ns_;
+    if (data_.recent_keyframes.erase(oldest) > 0 || long_link) {
+      JoinMap(oldest, window);
+    } else {
+      window.DropState(oldest);
+      dropped.push_back(oldest);
+      ++counts_.dropped;
+    }
+    data_.recent.erase(oldest);
+  }
+  counts_.most_states = std::max(counts_.most_states, static_cast<int>(window.states().size()));
+  return dropped;
+}
+
+void LocalMap::JoinMap(StateId id, Window& window) {
+  MapKeyframe keyframe;
+  keyframe.state = window.state(id);
+  for (const auto& [landmark, z] : window.ObservationsOf(id)) {
+    keyframe.observations[landmark] = z;
+    MapLandmark& l = data_.landmarks[landmark];
+    l.keyframes.insert(id);
+    l.p_w = window.landmark(landmark).position();
+  }
+  if (const ImuPreintegration* imu = window.ImuFactorInto(id, nullptr)) keyframe.imu_from_previous = *imu;
+  data_.keyframes[id] = std::move(keyframe);
+  data_.live.insert(id);
+  ++counts_.keyframes;
+}
+
+void LocalMap::Apply(const ActiveSet& set, const StereoFrame& frame, StateId state, Window& window,
+                     std::vector<StateId>* parked) {
+  const auto wanted = [&](StateId id) { return set.active.count(id) > 0 || set.fixed.count(id) > 0; };
+  std::vector<StateId> leaving;
+  for (StateId id : data_.live) {
+    if (!wanted(id)) leaving.push_back(id);
+  }
+  for (StateId id : leaving) Park(id, window);
+  for (const std::set<StateId>* group : {&set.active, &set.fixed}) {
+    for (StateId id : *group) {
+      if (data_.live.count(id) == 0) Unpark(id, window);
+    }
+  }
+  // Active keyframes free their poses; their speed/bias only for the newest, which the IMU
+  // factor into the recent window ties to it (the others' stay as last estimated: 9 fewer
+  // dense columns each).
+  const StateId newest = data_.keyframes.empty() ? StateId() : data_.keyframes.rbegin()->first;
+  for (StateId id : data_.live) {
+    window.SetStateConstant(id, set.fixed.count(id) > 0);
+    if (set.fixed.count(id) == 0 && id != newest) window.SetSpeedBiasConstant(id, true);
+  }
+  LinkChain(window);
+  SyncLandmarks(set, frame, state, window);
+  AddKeyframeObservations(window);
+  parked->insert(parked->end(), leaving.begin(), leaving.end());
+}
+
+// The keyframe's estimate and the IMU factors into it and out of it (re-preintegrated in the
+// window) go to the map; the state leaves the cost.
+void LocalMap::Park(StateId id, Window& window) {
+  MapKeyframe& keyframe = data_.keyframes.at(id);
+  keyframe.state = window.state(id);
+  if (const ImuPreintegration* imu = window.ImuFactorInto(id, nullptr)) keyframe.imu_from_previous = *imu;
+  auto next = data_.keyframes.upper_bound(id);
+  if (next != data_.keyframes.end() && data_.live.count(next->first) > 0) {
+    if (const ImuPreintegration* imu = window.ImuFactorInto(next->first, nullptr)) next->second.imu_from_previous = *imu;
+  }
+  window.RemoveState(id);
+  data_.live.erase(id);
+  ++counts_.parked;
+}
+
+void LocalMap::Unpark(StateId id, Window& window) {
+  const State& parked = data_.keyframes.at(id).state;
+  State& s = window.AddState(id, parked.t_ns);
+  std::copy(std::begin(parked.pose), std::end(parked.pose), std::begin(s.pose));
+  std::copy(std::begin(parked.speed_bias), std::end(parked.speed_bias), std::begin(s.speed_bias));
+  data_.live.insert(id);
+  ++counts_.unparked;
+}
+
+// Consecutive keyframes both in the window are tied by their IMU factor.
+void LocalMap::LinkChain(Window& window) const {
+  for (StateId id : data_.live) {
+    auto it = data_.keyframes.find(id);
+    if (it == data_.keyframes.begin() || !it->second.imu_from_previous) continue;
+    const StateId previous = std::prev(it)->first;
+    if (data_.live.count(previous) == 0 || window.ImuFactorInto(id, nullptr) != nullptr) continue;
+    window.AddImuFactor(previous, id, *it->second.imu_from_previous);
+  }
+}
+
+// Landmarks in the cost: those the recent frames and the active keyframes see. The others
+// (seen from fixed keyframes only, or from no state in the cost) are parked with their estimate;
+// parked ones the cost needs again come back when a state in it observes them, the frame's
+// own observation within the gate (else the frame sees a new landmark).
+void LocalMap::SyncLandmarks(const ActiveSet& set, const StereoFrame& frame, StateId state, Window& window) {
+  std::set<LandmarkId> needed = RecentLandmarks(data_);
+  for (StateId id : set.active) {
+    for (const auto& [landmark, z] : data_.keyframes.at(id).observations) needed.insert(landmark);
+  }
+  std::vector<LandmarkId> leaving;
+  for (const auto& [id, landmark] : window.landmarks()) {
+    if (needed.count(id) == 0 || landmark.observed_from.empty()) leaving.push_back(id);
+  }
+  for (LandmarkId id : leaving) {
+    auto it = data_.landmarks.find(id);
+    if (it != data_.landmarks.end()) it->second.p_w = window.landmark(id).position();
+    window.DropLandmark(id);
+  }
+  std::map<LandmarkId, Eigen::Vector3d> in_frame;
+  for (const StereoObservation& obs : frame.observations) in_frame[obs.landmark] = obs.z_px;
+  for (LandmarkId id : needed) {
+    auto it = data_.landmarks.find(id);
+    if (window.HasLandmark(id) || it == data_.landmarks.end()) continue;
+    const bool seen_live = std::any_of(it->second.keyframes.begin(), it->second.keyframes.end(),
+                                       [&](StateId k) { return data_.live.count(k) > 0; });
+    auto z = in_frame.find(id);
+    if (!seen_live && z == in_frame.end()) continue;
+    window.AddLandmark(id, it->second.p_w);
+    if (z == in_frame.end()) continue;
+    if (window.WhitenedError(state, id, z->second) <= gate_sigma_) {
+      ++counts_.landmark_returns;
+    } else if (!seen_live) {
+      window.DropLandmark(id);
+      ++counts_.gated;
+    }
+  }
+}
+
+// The live keyframes' observations of landmarks in the cost, each within the gate.
+void LocalMap::AddKeyframeObservations(Window& window) {
+  for (StateId id : data_.live) {
+    for (const auto& [landmark, z] : data_.keyframes.at(id).observations) {
+      if (!window.HasLandmark(landmark) || window.landmark(landmark).observed_from.count(id) > 0) continue;
+      if (!(window.WhitenedError(id, landmark, z) <= gate_sigma_)) {
+        ++counts_.gated;
+        continue;
+      }
+      window.AddObservation(id, landmark, z);
+    }
+  }
+}
+
+void LogLocalMapCounts(const LocalMap& map) {
+  if (!map.enabled()) return;
+  const LocalMapCounts& c = map.counts();
+  LOG(INFO) << "local map: " << c.keyframes << " keyframes, " << c.dropped << " frames dropped, " << c.parked
+            << " keyframes parked, " << c.unparked << " brought back, " << c.landmark_returns
+            << " parked landmarks observed again, " << c.gated << " observations beyond the gate not added again; at most "
+            << c.most_states << " states in the cost";
+}
+
+}  // namespace vio
