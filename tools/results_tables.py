@@ -25,7 +25,12 @@ def fmt(value, digits):
 
 
 def estimator_name(policy, window):
-    return policy if policy in ("batch", "ekf", "iekf") else f"{policy.upper()}({window})"
+    """batch, SWF(10), or SWF(10) + local map K=8 for the sweep's policy "swf+map8"."""
+    if policy in ("batch", "ekf", "iekf"):
+        return policy
+    base, _, keyframes = policy.partition("+map")
+    name = f"{base.upper()}({window})"
+    return f"{name} + local map K={keyframes}" if keyframes else name
 
 
 def hybrid(results_csv, eval_dir):
