@@ -93,6 +93,26 @@ TEST(ChainSolve, EqualsTheDenseStepWithAWindowsSparseCoupling) {
   EXPECT_LT((dx - expected).norm(), 1e-12 * expected.norm());
 }
 
+TEST(ChainSolve, EqualsTheDenseStepForLongChainsOfAnyLength) {
+  // Cyclic reduction runs over several levels (every other block, then every
+  // other of those, ...): chains of lengths that are not powers of two, each
+  // speed/bias block coupled to its two poses and the first one to all of them.
+  for (const int k : {2, 3, 5, 17, 37}) {
+    System system = MakeSystem(k, 1, 40 + k);
+    for (int i = 1; i < k; ++i) {
+      for (int p = 0; p < k; ++p) {
+        if (p == i || p == i + 1) continue;
+        system.H.block(6 * p, system.chain[i].offset, 6, 9).setZero();
+        system.H.block(system.chain[i].offset, 6 * p, 9, 6).setZero();
+      }
+    }
+    Eigen::VectorXd dx;
+    ASSERT_TRUE(ChainSolver().Solve(system.H, system.b, system.chain, 1, &dx)) << k;
+    const Eigen::VectorXd expected = DenseStep(system);
+    EXPECT_LT((dx - expected).norm(), 1e-12 * expected.norm()) << "a chain of " << k;
+  }
+}
+
 TEST(ChainSolve, AChainAfterOtherColumnsOrAlone) {
   System system = MakeSystem(8, 1, 11);
   Eigen::VectorXd dx;
