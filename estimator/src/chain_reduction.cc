@@ -15,29 +15,38 @@
 namespace vio {
 
 // The rest positions block c couples to, [lo, hi) from its first to its last
-// non-zero entry (zeros between are kept), and that part of H_chain,rest.
+// non-zero entry (zeros between are kept), and that part of H_chain,rest. The
+// rest columns before the chain block are read down H's columns (contiguous).
 void ChainSolver::FindRestCoupling(const Eigen::MatrixXd& H, const ChainBlock& c, Reduced* block) const {
   const int nr = static_cast<int>(rest_.size());
-  // H's entry (chain column c.offset + t, rest position p) from its upper triangle.
+  // H's entry (rest position p, chain column c.offset + t) from its upper triangle.
   const auto entry = [&](int p, int t) {
     const int col = rest_[static_cast<size_t>(p)];
     return col < c.offset ? H(col, c.offset + t) : H(c.offset + t, col);
   };
-  const auto coupled = [&](int p) {
-    for (int t = 0; t < c.size; ++t) {
-      if (entry(p, t) != 0.0) return true;
+  int lo = nr;
+  for (int t = 0; t < c.size; ++t) {
+    for (int p = 0; p < lo; ++p) {
+      if (entry(p, t) != 0.0) {
+        lo = p;
+        break;
+      }
     }
-    return false;
-  };
-  int lo = 0;
-  while (lo < nr && !coupled(lo)) ++lo;
-  int hi = nr;
-  while (hi > lo && !coupled(hi - 1)) --hi;
+  }
+  int hi = lo;
+  for (int t = 0; t < c.size; ++t) {
+    for (int p = nr - 1; p >= hi; --p) {
+      if (entry(p, t) != 0.0) {
+        hi = p + 1;
+        break;
+      }
+    }
+  }
   block->lo = lo;
   block->hi = hi;
   block->W.resize(c.size, hi - lo);
-  for (int p = lo; p < hi; ++p) {
-    for (int t = 0; t < c.size; ++t) block->W(t, p - lo) = entry(p, t);
+  for (int t = 0; t < c.size; ++t) {
+    for (int p = lo; p < hi; ++p) block->W(t, p - lo) = entry(p, t);
   }
 }
 
