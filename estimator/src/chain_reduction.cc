@@ -15,18 +15,24 @@
 namespace vio {
 
 // The rest positions block c couples to, [lo, hi) from its first to its last
-// non-zero entry (zeros between are kept), and that part of H_chain,rest. The
-// rest columns before the chain block are read down H's columns (contiguous).
+// non-zero entry (zeros between are kept), and that part of H_chain,rest. Only
+// the columns the caller gives are read (a window's speed/bias block: its two
+// poses), down H's columns (contiguous) for those before the chain block.
 void ChainSolver::FindRestCoupling(const Eigen::MatrixXd& H, const ChainBlock& c, Reduced* block) const {
-  const int nr = static_cast<int>(rest_.size());
+  // The rest positions within the columns the caller says may be non-zero.
+  const auto position = [&](int column) {
+    return static_cast<int>(std::lower_bound(rest_.begin(), rest_.end(), column) - rest_.begin());
+  };
+  const int begin = c.first_column < 0 ? 0 : position(c.first_column);
+  const int end = c.end_column < 0 ? static_cast<int>(rest_.size()) : position(c.end_column);
   // H's entry (rest position p, chain column c.offset + t) from its upper triangle.
   const auto entry = [&](int p, int t) {
     const int col = rest_[static_cast<size_t>(p)];
     return col < c.offset ? H(col, c.offset + t) : H(c.offset + t, col);
   };
-  int lo = nr;
+  int lo = end;
   for (int t = 0; t < c.size; ++t) {
-    for (int p = 0; p < lo; ++p) {
+    for (int p = begin; p < lo; ++p) {
       if (entry(p, t) != 0.0) {
         lo = p;
         break;
@@ -35,7 +41,7 @@ void ChainSolver::FindRestCoupling(const Eigen::MatrixXd& H, const ChainBlock& c
   }
   int hi = lo;
   for (int t = 0; t < c.size; ++t) {
-    for (int p = nr - 1; p >= hi; --p) {
+    for (int p = end - 1; p >= hi; --p) {
       if (entry(p, t) != 0.0) {
         hi = p + 1;
         break;
