@@ -131,14 +131,12 @@ void ChainSolver::SubtractCoupling() {
   }
 }
 
-// B = H_chain,rest and the upper triangle of S = H_rest,rest, copied block by
-// block: a run of consecutive rest columns lies wholly before or after a
-// chain block, so each piece is a block of H's upper triangle (or its
-// transpose), read column by column.
+// B = H_chain,rest, copied block by block: a run of consecutive rest columns
+// lies wholly before or after a chain block, so each piece is a block of H's
+// upper triangle (or its transpose), read column by column.
 void ChainSolver::GatherRest(const Eigen::MatrixXd& H, const std::vector<ChainBlock>& chain, int chain_dim) {
   const int nr = static_cast<int>(rest_.size());
   B_.resize(chain_dim, nr);
-  S_.resize(nr, nr);
   const std::vector<Run> runs = RunsOf(rest_);
   for (size_t i = 0; i < chain.size(); ++i) {
     const ChainBlock& c = chain[i];
@@ -151,6 +149,14 @@ void ChainSolver::GatherRest(const Eigen::MatrixXd& H, const std::vector<ChainBl
       }
     }
   }
+  GatherRestSquare(H);
+}
+
+// The upper triangle of S = H_rest,rest, run by run.
+void ChainSolver::GatherRestSquare(const Eigen::MatrixXd& H) {
+  const int nr = static_cast<int>(rest_.size());
+  S_.resize(nr, nr);
+  const std::vector<Run> runs = RunsOf(rest_);
   for (size_t a = 0; a < runs.size(); ++a) {
     const Run& ra = runs[a];
     S_.block(ra.position, ra.position, ra.length, ra.length).triangularView<Eigen::Upper>() =
@@ -192,6 +198,7 @@ bool ChainSolver::Solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, cons
   for (int c = 0; c < n; ++c) {
     if (!in_chain[c]) rest_.push_back(c);
   }
+  if (bandwidth <= 1) return SolveByReduction(H, b, chain, bandwidth, dx);
   if (!FactorChain(H, chain)) return false;
   const int nr = static_cast<int>(rest_.size());
   GatherRest(H, chain, static_cast<int>(chain_columns.size()));

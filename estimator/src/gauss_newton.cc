@@ -99,7 +99,12 @@ struct GaussNewtonSolver::System {
     chain_bandwidth = equations.CouplingBandwidth(position);
     const int m = static_cast<int>(layout.chain.size());
     if (m < 2 || 4 * (chain_bandwidth + 1) > m) return;
-    for (const int d : layout.chain) chain.push_back({equations.dense_offset(d), equations.dense_size(d)});
+    const std::vector<std::pair<int, int>> spans = equations.CoupledSpans();
+    for (const int d : layout.chain) {
+      const auto [first, last] = spans[static_cast<size_t>(d)];
+      chain.push_back({equations.dense_offset(d), equations.dense_size(d), equations.dense_offset(first),
+                       equations.dense_offset(last) + equations.dense_size(last)});
+    }
   }
 
   // The reduced system (H upper triangle, b) at the current values; false

@@ -312,6 +312,31 @@ int BlockSystem::Impl::CouplingBandwidth(const std::vector<int>& position) const
   return bandwidth;
 }
 
+std::vector<std::pair<int, int>> BlockSystem::Impl::CoupledSpans() const {
+  std::vector<std::pair<int, int>> spans(dense.size());
+  for (size_t d = 0; d < dense.size(); ++d) spans[d] = {static_cast<int>(d), static_cast<int>(d)};
+  const auto couple = [&](int low, int high, int d) {
+    spans[static_cast<size_t>(d)].first = std::min(spans[static_cast<size_t>(d)].first, low);
+    spans[static_cast<size_t>(d)].second = std::max(spans[static_cast<size_t>(d)].second, high);
+  };
+  const auto widen = [&](const auto& blocks, const auto& dense_of) {
+    int low = -1;
+    int high = -1;
+    for (const auto& block : blocks) {
+      const int d = dense_of(block);
+      if (d < 0) continue;
+      low = low < 0 ? d : std::min(low, d);
+      high = std::max(high, d);
+    }
+    for (const auto& block : blocks) {
+      const int d = dense_of(block);
+      if (d >= 0) couple(low, high, d);
+    }
+  };
+  for (const Residual& residual : residuals) widen(residual.slots, [](const Slot& slot) { return slot.dense; });
+  for (const EliminatedBlock& block : eliminated) widen(block.coupled, [](int d) { return d; });
+  return spans;
+}
 
 BlockSystem::BlockSystem(ceres::Problem* problem, BlockLayout layout, const RankThreshold& threshold)
     : impl_(std::make_unique<Impl>(problem, std::move(layout), threshold)) {}
@@ -338,5 +363,6 @@ bool BlockSystem::Cost(double* cost) { return impl_->Cost(cost); }
 int BlockSystem::CouplingBandwidth(const std::vector<int>& position) const {
   return impl_->CouplingBandwidth(position);
 }
+std::vector<std::pair<int, int>> BlockSystem::CoupledSpans() const { return impl_->CoupledSpans(); }
 
 }  // namespace vio::marginalization

@@ -2,6 +2,7 @@
 // system does, on systems shaped like a window's reduced one: a chain of 9-dim
 // blocks coupled within a band, interleaved with and densely (or, as in a
 // window, sparsely) coupled to 6-dim blocks, and refuses (returns false) when H is not positive definite.
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -91,6 +92,34 @@ TEST(ChainSolve, EqualsTheDenseStepWithAWindowsSparseCoupling) {
   ASSERT_TRUE(ChainSolver().Solve(system.H, system.b, system.chain, 1, &dx));
   const Eigen::VectorXd expected = DenseStep(system);
   EXPECT_LT((dx - expected).norm(), 1e-12 * expected.norm());
+  // Told the columns each block's rows may be non-zero in (as the window's
+  // solver is: its poses and its chain neighbours), the solver reads only those.
+  for (int i = 0; i < k; ++i) {
+    system.chain[i].first_column = i == 0 ? 0 : 6 * i;
+    system.chain[i].end_column = system.chain[std::min(i + 1, k - 1)].offset + 9;
+  }
+  ASSERT_TRUE(ChainSolver().Solve(system.H, system.b, system.chain, 1, &dx));
+  EXPECT_LT((dx - expected).norm(), 1e-12 * expected.norm());
+}
+
+TEST(ChainSolve, EqualsTheDenseStepForLongChainsOfAnyLength) {
+  // Cyclic reduction runs over several levels (every other block, then every
+  // other of those, ...): chains of lengths that are not powers of two, each
+  // speed/bias block coupled to its two poses and the first one to all of them.
+  for (const int k : {2, 3, 5, 17, 37}) {
+    System system = MakeSystem(k, 1, 40 + k);
+    for (int i = 1; i < k; ++i) {
+      for (int p = 0; p < k; ++p) {
+        if (p == i || p == i + 1) continue;
+        system.H.block(6 * p, system.chain[i].offset, 6, 9).setZero();
+        system.H.block(system.chain[i].offset, 6 * p, 9, 6).setZero();
+      }
+    }
+    Eigen::VectorXd dx;
+    ASSERT_TRUE(ChainSolver().Solve(system.H, system.b, system.chain, 1, &dx)) << k;
+    const Eigen::VectorXd expected = DenseStep(system);
+    EXPECT_LT((dx - expected).norm(), 1e-12 * expected.norm()) << "a chain of " << k;
+  }
 }
 
 TEST(ChainSolve, AChainAfterOtherColumnsOrAlone) {

@@ -7,6 +7,12 @@
 // over the poses (and prior-tied landmarks) only, so the cubic dense work is
 // over 6k columns instead of 15k for a window of k states. The solution is the
 // same as a dense Cholesky of the whole system up to round-off.
+//
+// A chain of bandwidth 0 or 1 (a window's speed/bias blocks) is eliminated by
+// block cyclic reduction (chain_reduction.cc): every other block first, then
+// every other of those, ..., so that a block's coupling to the rest grows only
+// with its level (2^l poses) instead of filling the whole chain x rest
+// product: O(k log k)-sized updates where the banded sweeps cost O(k^2).
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -18,6 +24,10 @@ namespace vio {
 struct ChainBlock {
   int offset = 0;
   int size = 0;
+  /// H's columns [first_column, end_column) hold every non-zero of the
+  /// block's rows (a superset is fine); -1: not known, all of them.
+  int first_column = -1;
+  int end_column = -1;
 };
 
 /// Solves H dx = -b, H symmetric positive definite given by its upper
@@ -37,6 +47,28 @@ class ChainSolver {
              Eigen::VectorXd* dx);
 
  private:
+  /// One chain block during cyclic reduction: its part of the system while it
+  /// remains, then (eliminated, with D = L L^T) L^-1 times its rows, kept for
+  /// the back-substitution.
+  struct Reduced {
+    Eigen::MatrixXd D;                ///< diagonal block
+    Eigen::LLT<Eigen::MatrixXd> llt;  ///< of D, once eliminated
+    Eigen::MatrixXd C[2];             ///< coupling to the left / right remaining neighbour (its rows)
+    int neighbour[2] = {-1, -1};      ///< chain index of that neighbour, -1 for none
+    RowMajorMatrix W;                 ///< coupling to the rest positions [lo, hi)
+    int lo = 0;
+    int hi = 0;
+    Eigen::VectorXd r;  ///< right-hand side (-b)
+  };
+
+  bool SolveByReduction(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, const std::vector<ChainBlock>& chain,
+                        int bandwidth, Eigen::VectorXd* dx);
+  void InitReduced(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, const std::vector<ChainBlock>& chain, int i,
+                   int bandwidth);
+  void FindRestCoupling(const Eigen::MatrixXd& H, const ChainBlock& c, Reduced* block) const;
+  bool EliminateReduced(int i);
+  void WidenRest(int lo, int hi, Reduced* block);
+  void GatherRestSquare(const Eigen::MatrixXd& H);
   bool FactorChain(const Eigen::MatrixXd& H, const std::vector<ChainBlock>& chain);
   /// N: the chain blocks' size when all share it at compile time, else Eigen::Dynamic.
   template <int N>
@@ -63,6 +95,9 @@ class ChainSolver {
   RowMajorMatrix w_;  ///< H_chain,chain^-1 b_chain (one column)
   RowMajorMatrix scratch_;  ///< one row block of a right-hand side
   Eigen::VectorXd dx_rest_;
+  std::vector<Reduced> reduced_;
+  std::vector<int> order_;  ///< the cyclic reduction's elimination order
+  RowMajorMatrix widened_;  ///< scratch of WidenRest
 };
 
 }  // namespace vio

@@ -17,6 +17,7 @@
 // layout. Blocks a residual touches outside the layout are held at their
 // values (no column).
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <ceres/problem.h>
@@ -79,6 +80,10 @@ class BlockSystem {
   /// blocks of one residual, or two dense blocks one eliminated block's Schur
   /// update ties together. A chain solver's bandwidth.
   int CouplingBandwidth(const std::vector<int>& position) const;
+  /// For each dense block, the first and last dense block (by index) the
+  /// reduced H couples it to (itself included): outside that span its rows
+  /// of H are zero.
+  std::vector<std::pair<int, int>> CoupledSpans() const;
 
  private:
   struct Impl;
