@@ -67,9 +67,14 @@ std::map<StateId, int> SharedLandmarks(const LocalMapData& map, const std::set<L
 ActiveSet SelectActiveSet(const LocalMapData& map, int keyframes) {
   ActiveSet set;
   if (map.keyframes.empty() || keyframes <= 0) return set;
-  set.active.insert(map.keyframes.rbegin()->first);
+  // The newest keyframe carries the IMU factor into the window: solved when a recent frame sees
+  // it, else held fixed (a tracking loss then dead-reckons from its last estimate, as the
+  // estimators without the map do from their prior, instead of freeing it on IMU factors alone).
   std::set<LandmarkId> landmarks = RecentLandmarks(map);
-  for (StateId id : MostShared(SharedLandmarks(map, landmarks))) {
+  const std::map<StateId, int> shared = SharedLandmarks(map, landmarks);
+  const StateId newest = map.keyframes.rbegin()->first;
+  (shared.count(newest) > 0 ? set.active : set.fixed).insert(newest);
+  for (StateId id : MostShared(shared)) {
     if (static_cast<int>(set.active.size()) >= keyframes) break;
     set.active.insert(id);
   }
@@ -112,27 +117,35 @@ StereoFrame LocalMap::Prepare(const StereoFrame& frame, StateId state, Window& w
   return gated;
 }
 
-std::optional<StateId> LocalMap::KeyframeLeaving() const {
+std::optional<StateId> LocalMap::KeyframeLeaving(const Window& window) const {
   if (static_cast<int>(data_.recent.size()) <= window_size_) return std::nullopt;
-  const StateId oldest = data_.recent.begin()->first;
-  if (data_.recent_keyframes.count(oldest) == 0) return std::nullopt;
-  return oldest;
+  const auto oldest = data_.recent.begin();
+  if (data_.recent_keyframes.count(oldest->first) > 0) return oldest->first;
+  // The long-link rule: a frame that saw nothing (tracking lost) never joins the map. It would be a
+  // keyframe no measurement but the IMU places, later held fixed as a chain neighbour: after a
+  // tracking loss the new window was then anchored to dead-reckoned poses and speeds.
+  const bool long_link = !data_.keyframes.empty() && !oldest->second.empty() &&
+                         window.state(std::next(oldest)->first).t_ns - data_.keyframes.rbegin()->second.state.t_ns >
+                             max_link_ns_;
+  if (long_link) return oldest->first;
+  return std::nullopt;
 }
 
 std::vector<StateId> LocalMap::Slide(Window& window) {
   std::vector<StateId> dropped;
   if (static_cast<int>(data_.recent.size()) > window_size_) {
     const StateId oldest = data_.recent.begin()->first;
-    const bool long_link = !data_.keyframes.empty() &&
-                           window.state(std::next(data_.recent.begin())->first).t_ns -
-                                   data_.keyframes.rbegin()->second.state.t_ns > max_link_ns_;
-    if (data_.recent_keyframes.erase(oldest) > 0 || long_link) {
+    // A state joins the map with landmarks in the cost or not at all: a blind keyframe (the MSCKF
+    // triangulated none of its tracks, as after a tracking loss) would only be a dead-reckoned
+    // pose and speed held fixed for the window to lean on.
+    if (KeyframeLeaving(window) && !window.ObservationsOf(oldest).empty()) {
       JoinMap(oldest, window);
     } else {
       window.DropState(oldest);
       dropped.push_back(oldest);
       ++counts_.dropped;
     }
+    data_.recent_keyframes.erase(oldest);
     data_.recent.erase(oldest);
   }
   counts_.most_states = std::max(counts_.most_states, static_cast<int>(window.states().size()));
@@ -247,7 +260,11 @@ void LocalMap::SyncLandmarks(const ActiveSet& set, const StereoFrame& frame, Sta
     if (z == in_frame.end()) continue;
     if (window.WhitenedError(state, id, z->second) <= gate_sigma_) {
       ++counts_.landmark_returns;
-    } else if (!seen_live) {
+    } else {
+      // The frame disagrees with the map's estimate (after a tracking loss the window has drifted
+      // from the map): the landmark stays parked and the frame's observation starts it anew, as
+      // the policy does for any landmark; the map's views are tied to it again, each within the
+      // gate, once it is back in the cost from the new frames.
       window.DropLandmark(id);
       ++counts_.gated;
     }

@@ -57,7 +57,7 @@ PolicyTiming MsckfPolicy::Update(const StereoFrame& given, StateId new_state, Wi
   std::vector<LandmarkId> retired;
   std::vector<TrackUpdate> updates = PromoteTracks(frame, leaving, window, retired);
   for (TrackUpdate& update : MatureTracks(frame, leaving)) updates.push_back(std::move(update));
-  if (const std::optional<StateId> keyframe = local_map_.KeyframeLeaving()) {
+  if (const std::optional<StateId> keyframe = local_map_.KeyframeLeaving(window)) {
     for (TrackUpdate& update : TracksSeenFrom(*keyframe)) updates.push_back(std::move(update));
   }
   const std::vector<LandmarkId> added = AddTriangulated(updates, window);

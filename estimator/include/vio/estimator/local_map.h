@@ -18,10 +18,14 @@
 // `local_map_max_link_s` (a camera circling a mapped place makes no keyframes
 // by overlap, and one IMU factor over minutes would cost more every frame):
 // the map's memory grows with the run's length, its cost per frame does not.
+// Around a tracking loss: a frame that saw nothing does not join by the link
+// rule, and no state joins without observations in the cost (a blind keyframe
+// is only dead reckoning).
 //
 // The active set of a solve (SelectActiveSet): the recent window, the newest
-// map keyframe (it carries the IMU factor into the window) and the keyframes
-// sharing most landmarks with the recent window, K in all; their poses,
+// map keyframe (it carries the IMU factor into the window; held fixed instead
+// when no recent frame sees it) and the keyframes sharing most landmarks with
+// the recent window, K in all; their poses,
 // speed/bias and landmarks are variables. Held fixed (conditioning): their
 // IMU neighbours in the keyframe chain and the K keyframes sharing most
 // landmarks with the active states. Every other keyframe, and every landmark
@@ -107,8 +111,9 @@ class LocalMap {
   /// (max_whitened_residual, as the estimator gates the others); `parked`
   /// gets the keyframes parked.
   StereoFrame Prepare(const StereoFrame& frame, StateId state, Window& window, std::vector<StateId>* parked);
-  /// The recent state the next Slide moves out of the recent window, when it is a keyframe.
-  std::optional<StateId> KeyframeLeaving() const;
+  /// The recent state the next Slide moves into the map (a keyframe, or a frame that saw
+  /// landmarks and would otherwise leave a longer IMU link than local_map_max_link_s).
+  std::optional<StateId> KeyframeLeaving(const Window& window) const;
   /// After the solve: the oldest state beyond the recent window joins the map
   /// (keyframe) or is dropped. Returns the dropped states.
   std::vector<StateId> Slide(Window& window);
