@@ -31,7 +31,7 @@
 // landmarks with the active states. Every other keyframe, and every landmark
 // no active state sees, is parked outside the cost (Window::RemoveState,
 // DropLandmark) with its last estimate, and comes back when the active set
-// needs it: the cost per frame is bounded by the window, 4K keyframes and
+// needs it: the cost per frame is bounded by the window, 4K + 2 keyframes and
 // their landmarks, whatever the run's length.
 //
 // Data (LocalMapData) and functions over it; LocalMap applies them to a
