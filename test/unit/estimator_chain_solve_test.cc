@@ -75,19 +75,27 @@ TEST(ChainSolve, EqualsTheDenseCholeskyStepForChainBlocksOfAnotherSize) {
   }
 }
 
+// Zeroes the coupling a window does not have between the chain and k poses:
+// speed/bias block i (i >= 1) keeps only poses i and i + 1 (its IMU factors);
+// the first block keeps every pose (a prior).
+void KeepOnlyAWindowsCoupling(System* system) {
+  const int k = static_cast<int>(system->chain.size());
+  for (int i = 1; i < k; ++i) {
+    for (int p = 0; p < k; ++p) {
+      if (p == i || p == i + 1) continue;
+      system->H.block(6 * p, system->chain[i].offset, 6, 9).setZero();
+      system->H.block(system->chain[i].offset, 6 * p, 9, 6).setZero();
+    }
+  }
+}
+
 TEST(ChainSolve, EqualsTheDenseStepWithAWindowsSparseCoupling) {
   // A window's coupling between the chain and the rest: speed/bias block i
   // touches poses i and i + 1 (IMU factors), the first one every pose (a
   // prior), and nothing else, so each chain block updates only its rows.
   const int k = 12;
   System system = MakeSystem(k, 1, 21);
-  for (int i = 1; i < k; ++i) {
-    for (int p = 0; p < k; ++p) {
-      if (p == i || p == i + 1) continue;
-      system.H.block(6 * p, system.chain[i].offset, 6, 9).setZero();
-      system.H.block(system.chain[i].offset, 6 * p, 9, 6).setZero();
-    }
-  }
+  KeepOnlyAWindowsCoupling(&system);
   Eigen::VectorXd dx;
   ASSERT_TRUE(ChainSolver().Solve(system.H, system.b, system.chain, 1, &dx));
   const Eigen::VectorXd expected = DenseStep(system);
@@ -108,13 +116,7 @@ TEST(ChainSolve, EqualsTheDenseStepForLongChainsOfAnyLength) {
   // speed/bias block coupled to its two poses and the first one to all of them.
   for (const int k : {2, 3, 5, 17, 37}) {
     System system = MakeSystem(k, 1, 40 + k);
-    for (int i = 1; i < k; ++i) {
-      for (int p = 0; p < k; ++p) {
-        if (p == i || p == i + 1) continue;
-        system.H.block(6 * p, system.chain[i].offset, 6, 9).setZero();
-        system.H.block(system.chain[i].offset, 6 * p, 9, 6).setZero();
-      }
-    }
+    KeepOnlyAWindowsCoupling(&system);
     Eigen::VectorXd dx;
     ASSERT_TRUE(ChainSolver().Solve(system.H, system.b, system.chain, 1, &dx)) << k;
     const Eigen::VectorXd expected = DenseStep(system);
