@@ -14,7 +14,7 @@ namespace {
 /// The PNG signature's length [bytes].
 constexpr size_t kPngSignatureBytes = 8;
 /// Larger images go to cv::imread, which refuses them (its own limit) [pixels].
-constexpr double kMaxPixels = 1 << 30;
+constexpr double kMaxLibpngImagePixels = 1 << 30;
 
 /// A libpng reader on an open file, released on every path.
 struct PngFile {
@@ -38,7 +38,8 @@ bool IsPlainGrey(png_structp png, png_infop info, png_uint_32* width, png_uint_3
   int depth = 0, color = 0, interlace = 0;
   png_get_IHDR(png, info, width, height, &depth, &color, &interlace, nullptr, nullptr);
   return depth == 8 && color == PNG_COLOR_TYPE_GRAY && interlace == PNG_INTERLACE_NONE &&
-         !png_get_valid(png, info, PNG_INFO_tRNS) && static_cast<double>(*width) * *height <= kMaxPixels;
+         !png_get_valid(png, info, PNG_INFO_tRNS) &&
+         static_cast<double>(*width) * *height <= kMaxLibpngImagePixels;
 }
 
 // Decodes the rows; false on a libpng error (truncated data, a bad CRC).
