@@ -38,13 +38,14 @@ MsckfPolicy::MsckfPolicy(const EstimatorOptions& options, std::optional<int> gn_
 PolicyTiming MsckfPolicy::Update(const StereoFrame& given, StateId new_state, Window& window) {
   PolicyTiming timing;
   auto start = std::chrono::steady_clock::now();
-  StereoFrame frame = given;
+  StereoFrame gated;  // the local map's: the frame without re-additions beyond the gate
   if (local_map_.enabled()) {
     std::vector<StateId> parked;
-    frame = local_map_.Prepare(given, new_state, window, &parked);
+    gated = local_map_.Prepare(given, new_state, window, &parked);
     ForgetObservationsOf(parked);
     AttachTracksOfLandmarksInTheCost(window);
   }
+  const StereoFrame& frame = local_map_.enabled() ? gated : given;
   for (const StereoObservation& obs : frame.observations) {
     if (window.HasLandmark(obs.landmark)) {  // a kept landmark: the observation re-attaches to it
       window.AddObservation(new_state, obs.landmark, obs.z_px);

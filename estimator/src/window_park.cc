@@ -1,6 +1,7 @@
 // Window operations of the local map (local_map.h): a keyframe parked outside
 // the cost and its bookkeeping read back.
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 
@@ -13,11 +14,11 @@ namespace vio {
 void Window::RemoveState(StateId id) {
   State& s = state(id);
   for (auto it = priors_.begin(); it != priors_.end();) {
-    const bool only_this = std::all_of(it->blocks.begin(), it->blocks.end(),
-                                       [&](const double* b) { return b == s.pose || b == s.speed_bias; });
-    const bool touches = std::any_of(it->blocks.begin(), it->blocks.end(),
-                                     [&](const double* b) { return b == s.pose || b == s.speed_bias; });
-    CHECK(!touches || only_this) << "state " << id.value << " shares a prior with other blocks";
+    const auto of_this = [&](const double* b) { return b == s.pose || b == s.speed_bias; };
+    const auto mine = std::count_if(it->blocks.begin(), it->blocks.end(), of_this);
+    const bool touches = mine > 0;
+    CHECK(!touches || mine == static_cast<std::ptrdiff_t>(it->blocks.size()))
+        << "state " << id.value << " shares a prior with other blocks";
     // The residual block goes with the state's parameter blocks below.
     it = touches ? priors_.erase(it) : std::next(it);
   }
