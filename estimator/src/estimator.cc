@@ -242,6 +242,7 @@ std::vector<FrameEstimate> Estimator::Finish() {
 
 std::vector<FrameEstimate> Estimator::LastEstimates() const {
   std::vector<FrameEstimate> last = left_window_;
+  for (const State& s : policy_->StatesBehindWindow(window_)) last.push_back(EstimateOf(s));
   for (const auto& [id, s] : window_.states()) last.push_back(EstimateOf(s));
   return last;
 }

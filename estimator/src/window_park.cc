@@ -31,15 +31,6 @@ void Window::RemoveState(StateId id) {
   states_.erase(id);
 }
 
-void Window::SetSpeedBiasConstant(StateId id, bool constant) {
-  State& s = state(id);
-  if (constant) {
-    problem_->SetParameterBlockConstant(s.speed_bias);
-  } else {
-    problem_->SetParameterBlockVariable(s.speed_bias);
-  }
-}
-
 std::vector<std::pair<LandmarkId, Eigen::Vector3d>> Window::ObservationsOf(StateId id) const {
   std::vector<std::pair<LandmarkId, Eigen::Vector3d>> out;
   for (auto it = observations_.lower_bound({id, LandmarkId(std::numeric_limits<std::int64_t>::min())});

@@ -342,12 +342,6 @@ void ValidateRequest(const RunRequest& request) {
     throw ConfigError("--trajectory=smoothed with --output_covariance: the covariances are of each frame's online "
                       "estimate (the newest state), not of the smoothed one; use one or the other");
   }
-  const int keyframes = request.config.estimator.local_map.local_map_keyframes;
-  if (request.trajectory == "smoothed" && keyframes > 0) {
-    throw ConfigError("--trajectory=smoothed with --local_map_keyframes=" + std::to_string(keyframes) +
-                      ": the local map parks keyframes outside the window, which the smoothed trajectory (the "
-                      "window's last estimates) does not hold; use --trajectory=online");
-  }
 }
 
 }  // namespace

@@ -58,7 +58,9 @@ class Estimator {
   /// Every estimated frame's state as last estimated: a state that left the
   /// window as it was when it left, one still in it as it is now. For a
   /// windowed policy, the output of a fixed-lag smoother (the lag is the
-  /// window); ProcessFrame's per-frame estimates are the filter's.
+  /// window); with the local map, its keyframes' latest estimates and the
+  /// other frames moved with them (LocalMap::LastStates). ProcessFrame's
+  /// per-frame estimates are the filter's.
   std::vector<FrameEstimate> LastEstimates() const;
 
   /// The body pose at t_ns predicted by the IMU from the newest state (for a

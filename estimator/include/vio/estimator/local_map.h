@@ -59,6 +59,13 @@ struct MapLandmark {
   std::set<StateId> keyframes;                    ///< map keyframes observing it
 };
 
+/// A frame dropped from the recent window (not a keyframe): its state as it left and the
+/// newest map keyframe's at that moment, so that its last estimate can move with the keyframe's.
+struct DroppedFrame {
+  State state;
+  std::optional<State> anchor;  ///< none when no keyframe had joined the map yet
+};
+
 /// The local map's bookkeeping.
 struct LocalMapData {
   std::map<StateId, MapKeyframe> keyframes;  ///< left the recent window, by id (= time) order
@@ -66,7 +73,13 @@ struct LocalMapData {
   std::map<StateId, std::vector<LandmarkId>> recent;  ///< the recent window: each frame's landmarks
   std::set<StateId> recent_keyframes;                 ///< recent states that are keyframes
   std::set<StateId> live;                             ///< map keyframes in the window (active or fixed)
+  std::vector<DroppedFrame> dropped;                  ///< in the order they left
 };
+
+/// A dropped frame's last estimate: its pose relative to its anchor keyframe as it left, composed
+/// with the keyframe's `anchor_now` (ORB-SLAM3 writes its frames relative to their reference
+/// keyframe so); speed turned with the keyframe, biases as they left.
+State FollowAnchor(const DroppedFrame& frame, const State& anchor_now);
 
 /// Which map keyframes a solve frees and which it holds fixed.
 struct ActiveSet {
@@ -117,6 +130,10 @@ class LocalMap {
   /// After the solve: the oldest state beyond the recent window joins the map
   /// (keyframe) or is dropped. Returns the dropped states.
   std::vector<StateId> Slide(Window& window);
+  /// Every state that left the recent window, as the map last estimates it: each keyframe at its
+  /// latest estimate (the window's while it is in it), each dropped frame with its anchor keyframe
+  /// (FollowAnchor). Empty when the map is off.
+  std::vector<State> LastStates(const Window& window) const;
   const LocalMapData& data() const { return data_; }
   const LocalMapCounts& counts() const { return counts_; }
 
@@ -129,6 +146,8 @@ class LocalMap {
   void SyncLandmarks(const ActiveSet& set, const StereoFrame& frame, StateId state, Window& window);
   void AddKeyframeObservations(Window& window);
   void JoinMap(StateId id, Window& window);
+  /// A keyframe's latest estimate: the window's while it is live, else the map's.
+  State LatestState(StateId keyframe, const Window& window) const;
 
   LocalMapOptions options_;
   int window_size_;

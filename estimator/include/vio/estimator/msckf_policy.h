@@ -67,6 +67,7 @@ class MsckfPolicy final : public Policy {
   const MsckfCounts& counts() const { return counts_; }
   const PersistentLandmarks& persistent() const { return persistent_; }
   const LocalMap& local_map() const { return local_map_; }
+  std::vector<State> StatesBehindWindow(const Window& window) const override { return local_map_.LastStates(window); }
 
  private:
   using Observation = std::pair<StateId, Eigen::Vector3d>;

@@ -6,6 +6,7 @@
 // bookkeeping (e.g. which tracks are pending).
 #include <chrono>
 #include <memory>
+#include <vector>
 
 #include "vio/estimator/estimator_options.h"
 #include "vio/estimator/window.h"
@@ -29,6 +30,9 @@ class Policy {
   /// Called once after the last frame. An offline policy (batch) solves here
   /// and returns true: the window's states are then the run's trajectory.
   virtual bool Finish(Window& /*window*/) { return false; }
+  /// States that left the window and that the policy still estimates (the local map's), as last
+  /// estimated; they replace those states' estimates as they left.
+  virtual std::vector<State> StatesBehindWindow(const Window& /*window*/) const { return {}; }
 };
 
 /// The policy named by options.policy.policy. Throws std::invalid_argument

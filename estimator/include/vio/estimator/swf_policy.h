@@ -28,6 +28,7 @@ class SwfPolicy final : public Policy {
   }
   const PersistentLandmarks& persistent() const { return persistent_; }
   const LocalMap& local_map() const { return local_map_; }
+  std::vector<State> StatesBehindWindow(const Window& window) const override { return local_map_.LastStates(window); }
 
  private:
   PolicyTiming UpdateWithLocalMap(const StereoFrame& frame, StateId new_state, Window& window);

@@ -147,8 +147,6 @@ class Window {
   /// factors: a keyframe the local map parks outside the cost. Landmarks it
   /// leaves unobserved stay. It must not share a prior with another block.
   void RemoveState(StateId id);
-  /// Holds a state's speed/bias block fixed in Solve (or frees it); the pose as it is.
-  void SetSpeedBiasConstant(StateId id, bool constant);
   /// What was removed since the last ClearRemovals (the estimator clears it
   /// every frame; the structural policy tests read it).
   const Removals& removals() const { return removals_; }
