@@ -6,6 +6,8 @@
 
 #include <glog/logging.h>
 
+#include "vio/estimator/stereo_factor.h"
+
 namespace vio {
 namespace {
 
@@ -144,6 +146,7 @@ std::vector<StateId> LocalMap::Slide(Window& window) {
       DroppedFrame frame{window.state(oldest), std::nullopt};
       if (!data_.keyframes.empty()) frame.anchor = LatestState(data_.keyframes.rbegin()->first, window);
       data_.dropped.push_back(frame);
+      Summarize(oldest, window);
       window.DropState(oldest);
       dropped.push_back(oldest);
       ++counts_.dropped;
@@ -176,6 +179,47 @@ State FollowAnchor(const DroppedFrame& frame, const State& anchor_now) {
               (q_now_then * frame.state.q_w_b()).normalized());
   out.SetSpeedBias(q_now_then * frame.state.v_w_b(), frame.state.gyro_bias(), frame.state.accel_bias());
   return out;
+}
+
+void LocalMap::Summarize(StateId frame, Window& window) {
+  if (data_.keyframes.empty()) return;
+  const StateId anchor = data_.keyframes.rbegin()->first;
+  MapKeyframe& keyframe = data_.keyframes.at(anchor);
+  const State& a = window.state(anchor);  // the newest keyframe is always live
+  const Eigen::Matrix3d R_w_a = a.q_w_b().toRotationMatrix();
+  const State& f = window.state(frame);
+  for (const auto& [landmark, z] : window.ObservationsOf(frame)) {
+    if (!(window.WhitenedError(frame, landmark, z) <= gate_sigma_)) continue;
+    const Landmark& l = window.landmark(landmark);
+    const StereoFactor factor(z, window.stereo(), pixel_sigma_);
+    const double* parameters[2] = {f.pose, l.p_w};
+    Eigen::Vector3d e0;
+    Eigen::Matrix<double, 3, 6, Eigen::RowMajor> J_pose;
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> J_w;
+    double* jacobians[2] = {J_pose.data(), J_w.data()};
+    if (!factor.EvaluateOnTangents(parameters, e0.data(), jacobians)) continue;
+    AnchoredPointSummary& summary = keyframe.anchored[landmark];
+    summary.Add(R_w_a.transpose() * (l.position() - a.p_w_b()), e0, J_w * R_w_a);
+    MapLandmark& m = data_.landmarks[landmark];
+    m.anchors.insert(anchor);
+    m.p_w = l.position();
+    if (summary.Usable()) window.SetAnchoredPoint(anchor, landmark, summary.mean(), summary.SqrtInformation());
+  }
+}
+
+void LocalMap::AddAnchoredPoints(StateId id, Window& window) {
+  for (const auto& [landmark, summary] : data_.keyframes.at(id).anchored) {
+    if (!window.HasLandmark(landmark) || window.landmark(landmark).anchored_to.count(id) > 0 || !summary.Usable()) {
+      continue;
+    }
+    const State& s = window.state(id);
+    const Eigen::Vector3d p_b = s.q_w_b().conjugate() * (window.landmark(landmark).position() - s.p_w_b());
+    if (!((summary.SqrtInformation() * (p_b - summary.mean())).norm() <= gate_sigma_)) {
+      ++counts_.gated;
+      continue;
+    }
+    window.SetAnchoredPoint(id, landmark, summary.mean(), summary.SqrtInformation());
+  }
 }
 
 void LocalMap::JoinMap(StateId id, Window& window) {
@@ -260,10 +304,13 @@ void LocalMap::SyncLandmarks(const ActiveSet& set, const StereoFrame& frame, Sta
   std::set<LandmarkId> needed = RecentLandmarks(data_);
   for (StateId id : set.active) {
     for (const auto& [landmark, z] : data_.keyframes.at(id).observations) needed.insert(landmark);
+    for (const auto& [landmark, summary] : data_.keyframes.at(id).anchored) needed.insert(landmark);
   }
   std::vector<LandmarkId> leaving;
   for (const auto& [id, landmark] : window.landmarks()) {
-    if (needed.count(id) == 0 || landmark.observed_from.empty()) leaving.push_back(id);
+    if (needed.count(id) == 0 || (landmark.observed_from.empty() && landmark.anchored_to.empty())) {
+      leaving.push_back(id);
+    }
   }
   for (LandmarkId id : leaving) {
     auto it = data_.landmarks.find(id);
@@ -275,8 +322,9 @@ void LocalMap::SyncLandmarks(const ActiveSet& set, const StereoFrame& frame, Sta
   for (LandmarkId id : needed) {
     auto it = data_.landmarks.find(id);
     if (window.HasLandmark(id) || it == data_.landmarks.end()) continue;
-    const bool seen_live = std::any_of(it->second.keyframes.begin(), it->second.keyframes.end(),
-                                       [&](StateId k) { return data_.live.count(k) > 0; });
+    const auto live = [&](StateId k) { return data_.live.count(k) > 0; };
+    const bool seen_live = std::any_of(it->second.keyframes.begin(), it->second.keyframes.end(), live) ||
+                           std::any_of(it->second.anchors.begin(), it->second.anchors.end(), live);
     auto z = in_frame.find(id);
     if (!seen_live && z == in_frame.end()) continue;
     window.AddLandmark(id, it->second.p_w);
@@ -305,6 +353,7 @@ void LocalMap::AddKeyframeObservations(Window& window) {
       }
       window.AddObservation(id, landmark, z);
     }
+    AddAnchoredPoints(id, window);
   }
 }
 

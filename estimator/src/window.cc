@@ -6,6 +6,7 @@
 
 #include <glog/logging.h>
 
+#include "vio/estimator/anchored_point_factor.h"
 #include "vio/estimator/imu_factor.h"
 #include "vio/estimator/pose_manifold.h"
 #include "vio/estimator/pose_prior_factor.h"
@@ -172,6 +173,21 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
   it->second.observed_from.insert(state_id);
 }
 
+void Window::SetAnchoredPoint(StateId anchor, LandmarkId landmark_id, const Eigen::Vector3d& p_b_hat,
+                              const Eigen::Matrix3d& sqrt_information) {
+  State& s = state(anchor);
+  auto it = landmarks_.find(landmark_id);
+  CHECK(it != landmarks_.end()) << "anchored point of unknown landmark " << landmark_id.value;
+  const ObservationKey key{anchor, landmark_id};
+  auto existing = anchored_points_.find(key);
+  if (existing != anchored_points_.end()) problem_->RemoveResidualBlock(existing->second);
+  anchored_points_[key] = problem_->AddResidualBlock(
+      WithFirstEstimates(Wrap(new AnchoredPointFactor(p_b_hat, sqrt_information)),
+                         {BlockKey::Pose(anchor), BlockKey::Landmark(landmark_id)}),
+      nullptr, s.pose, it->second.p_w);
+  it->second.anchored_to.insert(anchor);
+}
+
 std::vector<double*> Window::Blocks(const std::vector<StateId>& state_ids,
                                    const std::vector<LandmarkId>& landmark_ids) {
   std::vector<double*> blocks;
@@ -284,6 +300,10 @@ void Window::ForgetResidualsOf(const Leaving& leaving) {
     landmarks_.at(key.second).observed_from.erase(key.first);
     observations_.erase(key);
   }
+  for (const ObservationKey& key : AnchoredKeysOf(leaving)) {
+    landmarks_.at(key.second).anchored_to.erase(key.first);
+    anchored_points_.erase(key);
+  }
   for (auto it = imu_edges_.begin(); it != imu_edges_.end();) {
     it = Touches(it->first, it->second, leaving) ? imu_edges_.erase(it) : std::next(it);
   }
@@ -328,7 +348,7 @@ void Window::DropOutlierObservations(const std::vector<ObservationKey>& observat
     DropObservation(state_id, landmark_id);
     ++health_.dropped_observations;
     const Landmark& l = landmarks_.at(landmark_id);
-    if (l.observed_from.empty() && held.count(l.p_w) == 0) DropLandmark(landmark_id);
+    if (Unconstrained(l) && held.count(l.p_w) == 0) DropLandmark(landmark_id);
   }
 }
 
@@ -373,7 +393,13 @@ void Window::DropState(StateId id) {
   }
   for (LandmarkId landmark_id : seen) {
     DropObservation(id, landmark_id);
-    if (landmarks_.at(landmark_id).observed_from.empty()) DropLandmark(landmark_id);
+    if (Unconstrained(landmarks_.at(landmark_id))) DropLandmark(landmark_id);
+  }
+  for (const ObservationKey& key : AnchoredKeysOf(LeavingOf({id}, {}))) {
+    problem_->RemoveResidualBlock(anchored_points_.at(key));
+    anchored_points_.erase(key);
+    landmarks_.at(key.second).anchored_to.erase(id);
+    if (Unconstrained(landmarks_.at(key.second))) DropLandmark(key.second);
   }
   ImuEdge merged{incoming->second.from, outgoing->first, incoming->second.preintegration};
   merged.preintegration.Append(outgoing->second.preintegration);

@@ -23,6 +23,10 @@ void Window::RemoveState(StateId id) {
     it = touches ? priors_.erase(it) : std::next(it);
   }
   for (const auto& [landmark, z] : ObservationsOf(id)) DropObservation(id, landmark);
+  for (const ObservationKey& key : AnchoredKeysOf(LeavingOf({id}, {}))) {
+    landmarks_.at(key.second).anchored_to.erase(id);
+    anchored_points_.erase(key);  // the residual block goes with the pose below
+  }
   for (auto it = imu_edges_.begin(); it != imu_edges_.end();) {
     it = (it->second.from == id || it->first == id) ? imu_edges_.erase(it) : std::next(it);
   }

@@ -29,6 +29,7 @@ std::vector<ceres::ResidualBlockId> Window::ResidualOrder() const {
   for (const Prior& prior : priors_) order.push_back(prior.residual);
   for (const auto& [to, edge] : imu_edges_) order.push_back(edge.residual);
   for (const auto& [key, observation] : observations_) order.push_back(observation.residual);
+  for (const auto& [key, residual] : anchored_points_) order.push_back(residual);
   CHECK_EQ(static_cast<int>(order.size()), problem_->NumResidualBlocks()) << "a residual block the window does not know";
   return order;
 }
@@ -45,6 +46,20 @@ std::set<Window::ObservationKey> Window::ObservationKeysOf(const Leaving& leavin
   }
   for (LandmarkId id : leaving.landmarks) {
     for (StateId from : landmarks_.at(id).observed_from) keys.insert({from, id});
+  }
+  return keys;
+}
+
+std::set<Window::ObservationKey> Window::AnchoredKeysOf(const Leaving& leaving) const {
+  std::set<ObservationKey> keys;
+  for (StateId id : leaving.states) {
+    for (auto it = anchored_points_.lower_bound({id, LandmarkId(std::numeric_limits<std::int64_t>::min())});
+         it != anchored_points_.end() && it->first.first == id; ++it) {
+      keys.insert(it->first);
+    }
+  }
+  for (LandmarkId id : leaving.landmarks) {
+    for (StateId anchor : landmarks_.at(id).anchored_to) keys.insert({anchor, id});
   }
   return keys;
 }
@@ -67,6 +82,7 @@ std::vector<ceres::ResidualBlockId> Window::ResidualOrderOf(const Leaving& leavi
     if (Touches(to, edge, leaving)) order.push_back(edge.residual);
   }
   for (const ObservationKey& key : ObservationKeysOf(leaving)) order.push_back(observations_.at(key).residual);
+  for (const ObservationKey& key : AnchoredKeysOf(leaving)) order.push_back(anchored_points_.at(key));
   return order;
 }
 

@@ -13,7 +13,12 @@
 // window it joins the map if it is a keyframe and is dropped otherwise
 // (Window::DropState: its observations go, its two IMU factors merge), so
 // consecutive keyframes stay tied by IMU preintegration over the frames
-// between them; a state leaving the recent window also joins the map when the
+// between them. A dropped frame's observations are not lost: each goes,
+// linearized, into a summary per landmark in the body frame of the newest
+// keyframe (AnchoredPointSummary: the frame's pose relative to that keyframe
+// held as estimated), one 3-row residual per keyframe and landmark
+// (AnchoredPointFactor), so the map keeps what every frame saw at the cost of
+// its keyframes; a state leaving the recent window also joins the map when the
 // IMU factor from the last keyframe would otherwise span more than
 // `local_map_max_link_s` (a camera circling a mapped place makes no keyframes
 // by overlap, and one IMU factor over minutes would cost more every frame):
@@ -41,6 +46,7 @@
 #include <set>
 #include <vector>
 
+#include "vio/estimator/anchored_point_factor.h"
 #include "vio/estimator/estimator_options.h"
 #include "vio/estimator/window.h"
 
@@ -51,12 +57,16 @@ struct MapKeyframe {
   State state;
   std::map<LandmarkId, Eigen::Vector3d> observations;   ///< z = (u_L, u_R, v) [px]
   std::optional<ImuPreintegration> imu_from_previous;   ///< from the keyframe before it
+  /// The observations of the frames dropped while it was the newest keyframe, per landmark,
+  /// summarized in its body frame (their poses relative to it held as they were estimated).
+  std::map<LandmarkId, AnchoredPointSummary> anchored;
 };
 
 /// A landmark seen from a map keyframe.
 struct MapLandmark {
   Eigen::Vector3d p_w = Eigen::Vector3d::Zero();  ///< last estimate [m]
   std::set<StateId> keyframes;                    ///< map keyframes observing it
+  std::set<StateId> anchors;                      ///< map keyframes holding a summary of it
 };
 
 /// A frame dropped from the recent window (not a keyframe): its state as it left and the
@@ -114,6 +124,7 @@ class LocalMap {
       : options_(options.local_map),
         window_size_(options.policy.window_size),
         gate_sigma_(options.model.max_whitened_residual),
+        pixel_sigma_(options.model.pixel_sigma),
         max_link_ns_(SecondsToNanos(options.local_map.local_map_max_link_s)) {}
   bool enabled() const { return options_.local_map_keyframes > 0; }
 
@@ -146,12 +157,17 @@ class LocalMap {
   void SyncLandmarks(const ActiveSet& set, const StereoFrame& frame, StateId state, Window& window);
   void AddKeyframeObservations(Window& window);
   void JoinMap(StateId id, Window& window);
+  /// The observations of `frame`, about to be dropped, into the newest keyframe's summaries.
+  void Summarize(StateId frame, Window& window);
+  /// Adds a live keyframe's summaries of landmarks in the cost, each within the gate.
+  void AddAnchoredPoints(StateId keyframe, Window& window);
   /// A keyframe's latest estimate: the window's while it is live, else the map's.
   State LatestState(StateId keyframe, const Window& window) const;
 
   LocalMapOptions options_;
   int window_size_;
   double gate_sigma_;  ///< observations the map adds again must be predicted this well [sigma]
+  double pixel_sigma_;  ///< stereo observation noise [px]
   Timestamp max_link_ns_;  ///< longest IMU factor between keyframes
   LocalMapData data_;
   LocalMapCounts counts_;

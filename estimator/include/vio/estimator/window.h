@@ -46,6 +46,7 @@ struct Landmark {
   LandmarkId id;
   double p_w[3] = {};               ///< [m]
   std::set<StateId> observed_from;  ///< states with an observation residual
+  std::set<StateId> anchored_to;    ///< states with an anchored-point residual (SetAnchoredPoint)
 
   Eigen::Vector3d position() const { return Eigen::Vector3d(p_w[0], p_w[1], p_w[2]); }
 };
@@ -98,6 +99,10 @@ class Window {
   Landmark& AddLandmark(LandmarkId id, const Eigen::Vector3d& p_w);
   /// Stereo observation z = (u_L, u_R, v) [px] of `landmark` from `state`.
   void AddObservation(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px);
+  /// The landmark measured in `anchor`'s body frame (AnchoredPointFactor, no loss): the local
+  /// map's summary of the observations of frames it dropped. Replaces the pair's earlier one.
+  void SetAnchoredPoint(StateId anchor, LandmarkId landmark, const Eigen::Vector3d& p_b_hat,
+                        const Eigen::Matrix3d& sqrt_information);
   /// A linear factor r = residual + jacobian [x ⊟ x0], x0 the current values, over the states'
   /// [pose, speed_bias] and the landmarks in that order; kept as a prior. A Gaussian N(x0, Σ) is
   /// jacobian = Σ^-1/2, residual = 0. Throws std::invalid_argument on inconsistent sizes.
@@ -229,6 +234,12 @@ class Window {
   /// Drops `observations`, and a landmark left unobserved that no prior holds.
   void DropOutlierObservations(const std::vector<ObservationKey>& observations);
   void RemoveStateBookkeeping(StateId id);
+  /// The anchored points of the states and landmarks that leave, by ids.
+  std::set<ObservationKey> AnchoredKeysOf(const Leaving& leaving) const;
+  /// Unobserved and unanchored: a landmark no residual but a prior's holds.
+  static bool Unconstrained(const Landmark& landmark) {
+    return landmark.observed_from.empty() && landmark.anchored_to.empty();
+  }
   /// FEJ (model.fej): `factor` wrapped to take its Jacobians on held blocks at
   /// their first estimates; `factor` itself without FEJ.
   ceres::CostFunction* WithFirstEstimates(ceres::CostFunction* factor, std::vector<BlockKey> keys) const;
@@ -247,6 +258,7 @@ class Window {
   std::map<LandmarkId, Landmark> landmarks_;
   std::map<StateId, ImuEdge> imu_edges_;  ///< keyed by the later state (`to`)
   std::map<ObservationKey, Observation> observations_;
+  std::map<ObservationKey, ceres::ResidualBlockId> anchored_points_;
   std::vector<Prior> priors_;
   std::shared_ptr<FirstEstimates> first_estimates_;  ///< model.fej: the held blocks; else null
   Removals removals_;
