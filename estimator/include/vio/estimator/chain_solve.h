@@ -24,8 +24,9 @@ namespace vio {
 struct ChainBlock {
   int offset = 0;
   int size = 0;
-  /// H's columns [first_column, end_column) hold every non-zero of the
-  /// block's rows (a superset is fine); -1: not known, all of them.
+  /// Among the columns not in the chain, [first_column, end_column) hold
+  /// every non-zero of the block's rows (a superset is fine); -1: not known,
+  /// all of them.
   int first_column = -1;
   int end_column = -1;
 };
