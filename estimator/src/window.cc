@@ -247,6 +247,11 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   const Leaving leaving = LeavingOf(state_ids, landmark_ids);
   marginalization::MarginalizationOptions options;
   options.residual_order = ResidualOrderOf(leaving);
+  // A window's marginal is rank-deficient frame after frame (poses and
+  // directions the marginalized observations leave unconstrained): after a
+  // rank-deficient prior the unpivoted attempt, a whole factorization that
+  // would fail, is skipped.
+  if (last_prior_rank_deficient_) options.sqrt_method = marginalization::SqrtMethod::kPivotedCholeskyOnly;
   if (first_estimates_) {
     options.first_estimate = [this](const double* block) { return first_estimates_->Find(KeyOf(block)); };
   }
@@ -256,9 +261,13 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   order.erase(std::remove_if(order.begin(), order.end(), [&](ceres::ResidualBlockId id) { return dropped.count(id) > 0; }),
               order.end());
   ceres::ResidualBlockId prior = marginalization::MarginalizeBlocks(problem_.get(), blocks, options);
+  last_prior_rank_deficient_ = false;
   if (prior != nullptr) {
     std::vector<double*> kept;
     problem_->GetParameterBlocksForResidualBlock(prior, &kept);
+    int tangent_dim = 0;
+    for (const double* block : kept) tangent_dim += problem_->ParameterBlockTangentSize(block);
+    last_prior_rank_deficient_ = problem_->GetCostFunctionForResidualBlock(prior)->num_residuals() < tangent_dim;
     priors_.push_back(Prior{prior, {kept.begin(), kept.end()}});
     HoldFirstEstimates(kept);
   }

@@ -687,8 +687,8 @@ class NonlinearPosesTest : public ::testing::Test {
 };
 
 TEST_F(NonlinearPosesTest, PriorAtTheLinearizationPointIsTheoremTwoTwoTwo) {
-  for (const SqrtMethod method : {SqrtMethod::kEigen, SqrtMethod::kPivotedCholesky}) {
-    SCOPED_TRACE(method == SqrtMethod::kEigen ? "kEigen" : "kPivotedCholesky");
+  for (const SqrtMethod method : {SqrtMethod::kEigen, SqrtMethod::kPivotedCholesky, SqrtMethod::kPivotedCholeskyOnly}) {
+    SCOPED_TRACE(static_cast<int>(method));
     MarginalizationOptions options;
     options.sqrt_method = method;
     const MarginalizationResult result = ComputeMarginalization(&problem_, {q0_, p0_}, options);
