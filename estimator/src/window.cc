@@ -247,10 +247,8 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   const Leaving leaving = LeavingOf(state_ids, landmark_ids);
   marginalization::MarginalizationOptions options;
   options.residual_order = ResidualOrderOf(leaving);
-  // A window's marginal is rank-deficient frame after frame (poses and
-  // directions the marginalized observations leave unconstrained): after a
-  // rank-deficient prior the unpivoted attempt, a whole factorization that
-  // would fail, is skipped.
+  // Rank-deficient priors come in runs: after one, no unpivoted attempt at the
+  // next square root (a whole factorization that would fail its pivot test).
   if (last_prior_rank_deficient_) options.sqrt_method = marginalization::SqrtMethod::kPivotedCholeskyOnly;
   if (first_estimates_) {
     options.first_estimate = [this](const double* block) { return first_estimates_->Find(KeyOf(block)); };
