@@ -12,8 +12,8 @@
 #   --rows        a subset of: swf5 swf10 swf30 swf50 msckf10 ekf keyframe brisk klt real_micro real_flight
 #                 (real_micro: the 95 static pairs V1_01_easy_micro, the configuration's start; real_flight: the 10 pairs
 #                 in flight V1_01_easy_flight10, ground-truth start; both read in place from EUROC)
-#   --baseline    another vio binary (e.g. an older build) run on the image rows too, each of its runs
-#                 right after the same run of this build; the ratios compare the two
+#   --baseline    another vio binary (e.g. an older build) run on the image, SWF and MSCKF rows too, each of
+#                 its runs right after the same run of this build; the ratios compare the two
 #   --real_loops  runs of each real row (default 3; the real clips are short, so they are run again: each
 #                 run is one clip, the figures are the medians over the runs)
 #   --repeat      runs per row (default 1): ms/frame and the stage times are then the
@@ -115,7 +115,7 @@ fi
 # One row: name, dataset, description, then the run's flags; `repeat` runs,
 # each in its own folder, summarized by their medians. The binary is $row_vio
 # ($vio unless set), the pinning $row_pin (one core unless set, as words);
-# with --baseline, image rows pass row_compare=1 and each run is followed by
+# with --baseline, image, SWF and MSCKF rows pass row_compare=1 and each run is followed by
 # the baseline's (row NAME@base; flags it does not know are left out).
 run_row() {
   local name="$1" dataset="$2" what="$3"; shift 3
@@ -184,9 +184,9 @@ IFS=, read -r -a selected <<< "$rows"
 for row in "${selected[@]}"; do
   case "$row" in
     swf5|swf10|swf30|swf50)
-      run_row "$row" "$hybrid" "SWF(${row#swf}), hybrid V2_01 features" --frontend=features --policy=swf \
+      row_compare=1 run_row "$row" "$hybrid" "SWF(${row#swf}), hybrid V2_01 features" --frontend=features --policy=swf \
         --window_size="${row#swf}" ;;
-    msckf10) run_row "$row" "$hybrid" "MSCKF(10), hybrid V2_01 features" --frontend=features --policy=msckf \
+    msckf10) row_compare=1 run_row "$row" "$hybrid" "MSCKF(10), hybrid V2_01 features" --frontend=features --policy=msckf \
         --window_size=10 ;;
     ekf) run_row "$row" "$hybrid" "EKF marginalize_unseen, hybrid V2_01" --frontend=features --policy=ekf \
         --ekf_landmarks=marginalize_unseen ;;
@@ -246,10 +246,17 @@ def rss(name):
              for p in glob.glob(f"{runs}/{name}/run_*/time.txt")]
     return max(sizes) / 1024 if sizes else None
 print("ratios (medians of this call's runs):")
-swf10, swf50, msckf10 = (median(r, ms) for r in ("swf10", "swf50", "msckf10"))
-if swf10 and swf50: print(f"  SWF(50) / SWF(10) ms/frame: {swf50 / swf10:.2f} (target <= 4)")
-if swf10 and msckf10: print(f"  MSCKF(10) / SWF(10) ms/frame: {msckf10 / swf10:.2f} (target <= 0.5)")
-if rss("msckf10"): print(f"  MSCKF(10) peak RSS: {rss('msckf10'):.1f} MB (target <= 80)")
+for build in ("", "@base"):
+    swf10, swf50, msckf10 = (median(r + build, ms) for r in ("swf10", "swf50", "msckf10"))
+    if swf10 and swf50: print(f"  SWF(50) / SWF(10) ms/frame{build}: {swf50 / swf10:.2f} (target <= 4)")
+    if swf10 and msckf10: print(f"  MSCKF(10) / SWF(10) ms/frame{build}: {msckf10 / swf10:.2f} (target <= 0.5)")
+    if rss("msckf10" + build): print(f"  MSCKF(10) peak RSS{build}: {rss('msckf10' + build):.1f} MB (target <= 80)")
+for row in ("swf5", "swf10", "swf30", "swf50", "msckf10"):  # run k of this build against run k of the baseline
+    pairs = list(zip(rows(row), rows(row + "@base")))
+    if pairs:
+        ratios = [ms(new) / ms(base) for new, base in pairs]
+        print(f"  {row} / {row}@base ms/frame, paired runs: median {statistics.median(ratios):.3f} "
+              f"({', '.join(f'{r:.3f}' for r in ratios)})")
 for row in ("real_micro", "real_flight"):
     one, two = f"{row}_1core", f"{row}_2cores"
     if not rows(one): continue

@@ -169,11 +169,7 @@ bool ChainSolver::SolveByReduction(const Eigen::MatrixXd& H, const Eigen::Vector
   for (const int i : order_) {
     if (!EliminateReduced(i)) return false;
   }
-  if (nr > 0) {
-    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Upper> llt(S_);  // in place
-    if (llt.info() != Eigen::Success) return false;
-    llt.solveInPlace(dx_rest_);
-  }
+  if (nr > 0 && !SolveRest(&dx_rest_)) return false;
   dx->resize(H.rows());
   (*dx)(rest_) = dx_rest_;
   for (auto it = order_.rbegin(); it != order_.rend(); ++it) {

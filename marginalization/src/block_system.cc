@@ -312,22 +312,28 @@ int BlockSystem::Impl::CouplingBandwidth(const std::vector<int>& position) const
   return bandwidth;
 }
 
-std::vector<std::pair<int, int>> BlockSystem::Impl::CoupledSpans() const {
-  std::vector<std::pair<int, int>> spans(dense.size());
-  for (size_t d = 0; d < dense.size(); ++d) spans[d] = {static_cast<int>(d), static_cast<int>(d)};
+std::vector<std::pair<int, int>> BlockSystem::Impl::CoupledSpans(const std::vector<bool>& counted) const {
+  const auto is_counted = [&](int d) { return counted.empty() || counted[static_cast<size_t>(d)]; };
+  // Per block, the counted span so far; (-1, -1) while it has none.
+  std::vector<std::pair<int, int>> spans(dense.size(), {-1, -1});
+  for (size_t d = 0; d < dense.size(); ++d) {
+    if (is_counted(static_cast<int>(d))) spans[d] = {static_cast<int>(d), static_cast<int>(d)};
+  }
   const auto couple = [&](int low, int high, int d) {
-    spans[static_cast<size_t>(d)].first = std::min(spans[static_cast<size_t>(d)].first, low);
-    spans[static_cast<size_t>(d)].second = std::max(spans[static_cast<size_t>(d)].second, high);
+    auto& span = spans[static_cast<size_t>(d)];
+    span.first = span.first < 0 ? low : std::min(span.first, low);
+    span.second = std::max(span.second, high);
   };
   const auto widen = [&](const auto& blocks, const auto& dense_of) {
     int low = -1;
     int high = -1;
     for (const auto& block : blocks) {
       const int d = dense_of(block);
-      if (d < 0) continue;
+      if (d < 0 || !is_counted(d)) continue;
       low = low < 0 ? d : std::min(low, d);
       high = std::max(high, d);
     }
+    if (low < 0) return;
     for (const auto& block : blocks) {
       const int d = dense_of(block);
       if (d >= 0) couple(low, high, d);
@@ -335,6 +341,9 @@ std::vector<std::pair<int, int>> BlockSystem::Impl::CoupledSpans() const {
   };
   for (const Residual& residual : residuals) widen(residual.slots, [](const Slot& slot) { return slot.dense; });
   for (const EliminatedBlock& block : eliminated) widen(block.coupled, [](int d) { return d; });
+  for (size_t d = 0; d < dense.size(); ++d) {
+    if (spans[d].first < 0) spans[d] = {static_cast<int>(d), static_cast<int>(d)};
+  }
   return spans;
 }
 
@@ -363,6 +372,8 @@ bool BlockSystem::Cost(double* cost) { return impl_->Cost(cost); }
 int BlockSystem::CouplingBandwidth(const std::vector<int>& position) const {
   return impl_->CouplingBandwidth(position);
 }
-std::vector<std::pair<int, int>> BlockSystem::CoupledSpans() const { return impl_->CoupledSpans(); }
+std::vector<std::pair<int, int>> BlockSystem::CoupledSpans(const std::vector<bool>& counted) const {
+  return impl_->CoupledSpans(counted);
+}
 
 }  // namespace vio::marginalization

@@ -166,7 +166,7 @@ struct BlockSystem::Impl {
   void BackSubstitute(const Eigen::VectorXd& dx_dense, Eigen::VectorXd* dx) const;
   bool Cost(double* cost);
   int CouplingBandwidth(const std::vector<int>& position) const;
-  std::vector<std::pair<int, int>> CoupledSpans() const;
+  std::vector<std::pair<int, int>> CoupledSpans(const std::vector<bool>& counted) const;
 
   // block_system_assembly.cc: the normal equations at the current values (and
   // the blocks of H an assembly writes, cleared before the next).

@@ -261,13 +261,15 @@ PivotedCholesky PivotedCholeskyOf(const Eigen::MatrixXd& H_symmetric, double cut
 }
 
 SqrtInformation SqrtByPivotedCholesky(const Eigen::MatrixXd& H, const Eigen::VectorXd& b,
-                                      const RankThreshold& threshold) {
+                                      const RankThreshold& threshold, bool unpivoted_first) {
   const int n = static_cast<int>(H.rows());
   if (n == 0) {
     return {Eigen::MatrixXd(0, 0), Eigen::VectorXd(0), Eigen::MatrixXd(0, 0)};
   }
   Eigen::MatrixXd H_symmetric = SymmetricPart(H);
-  if (std::optional<SqrtInformation> cholesky = SqrtByCholesky(H_symmetric, b, threshold)) {
+  std::optional<SqrtInformation> cholesky;
+  if (unpivoted_first) cholesky = SqrtByCholesky(H_symmetric, b, threshold);
+  if (cholesky) {
     cholesky->information = std::move(H_symmetric);
     return *std::move(cholesky);
   }
@@ -343,8 +345,8 @@ SqrtInformation SqrtInformationFromHessian(const Eigen::MatrixXd& H, const Eigen
                                            const RankThreshold& threshold, SqrtMethod method) {
   RequireSizes(H, b, static_cast<int>(H.rows()), 0, "SqrtInformationFromHessian");
   RequireFinite(H, b, "SqrtInformationFromHessian");
-  return method == SqrtMethod::kEigen ? SqrtByEigen(H, b, threshold)
-                                      : SqrtByPivotedCholesky(H, b, threshold);
+  if (method == SqrtMethod::kEigen) return SqrtByEigen(H, b, threshold);
+  return SqrtByPivotedCholesky(H, b, threshold, /*unpivoted_first=*/method == SqrtMethod::kPivotedCholesky);
 }
 
 }  // namespace vio::marginalization

@@ -261,7 +261,7 @@ TEST_P(SqrtInformationFromHessianTest, KeepsTheRankOfAWindowLikeMarginal) {
     const Eigen::MatrixXd& Jp = prior.sqrt_information;
     ASSERT_EQ(Jp.rows(), 56) << "seed " << seed;
     EXPECT_LT(RelativeError(Jp.transpose() * Jp, eq.H), 1e-13) << "seed " << seed;
-    if (GetParam() == SqrtMethod::kPivotedCholesky) {
+    if (GetParam() != SqrtMethod::kEigen) {
       // L^T P, not the eigen fallback: upper trapezoidal up to the column order.
       const Eigen::Index rank = Jp.rows(), n = Jp.cols();
       EXPECT_LE((Jp.array() != 0.0).count(), rank * n - rank * (rank - 1) / 2) << "seed " << seed;
@@ -280,6 +280,25 @@ TEST(SqrtInformationFromHessian, DefiniteInformationTakesTheCholeskyFactor) {
   EXPECT_TRUE(Jp.isUpperTriangular(0.0));
   EXPECT_EQ(prior.information, H);  // the factored matrix itself
   EXPECT_LT(RelativeError(Jp.transpose() * Jp, H), 1e-12);
+}
+
+// Without the unpivoted attempt a definite H takes the pivoted factor: the
+// same information, Jp an orthogonal transform of the Cholesky factor's rows,
+// the same r0^T r0 and Jp^T r0 up to round-off.
+TEST(SqrtInformationFromHessian, PivotedOnlyGivesTheCholeskyPriorOfADefiniteInformation) {
+  std::mt19937 rng(15);
+  const Eigen::MatrixXd J = RandomMatrix(40, 18, &rng);
+  const Eigen::MatrixXd H = J.transpose() * J;
+  const Eigen::VectorXd b = J.transpose() * RandomMatrix(40, 1, &rng);
+  const SqrtInformation cholesky = SqrtInformationFromHessian(H, b, {}, SqrtMethod::kPivotedCholesky);
+  const SqrtInformation pivoted = SqrtInformationFromHessian(H, b, {}, SqrtMethod::kPivotedCholeskyOnly);
+  ASSERT_EQ(pivoted.sqrt_information.rows(), 18);
+  EXPECT_FALSE(pivoted.sqrt_information.isUpperTriangular(0.0));  // pivoted: not the plain factor
+  EXPECT_EQ(pivoted.information, cholesky.information);  // the factored matrix itself
+  EXPECT_LT(RelativeError(pivoted.sqrt_information.transpose() * pivoted.sqrt_information, H), 1e-12);
+  EXPECT_NEAR(pivoted.residual.squaredNorm(), cholesky.residual.squaredNorm(), 1e-10 * cholesky.residual.squaredNorm());
+  EXPECT_LT(RelativeError(pivoted.sqrt_information.transpose() * pivoted.residual,
+                          cholesky.sqrt_information.transpose() * cholesky.residual), 1e-10);
 }
 
 TEST_P(SqrtInformationFromHessianTest, ZeroInformationGivesNoRows) {
@@ -342,10 +361,16 @@ TEST_P(SqrtInformationFromHessianTest, RejectsNonSquareInput) {
                std::invalid_argument);
 }
 
-INSTANTIATE_TEST_SUITE_P(BothMethods, SqrtInformationFromHessianTest,
-                         ::testing::Values(SqrtMethod::kEigen, SqrtMethod::kPivotedCholesky),
+INSTANTIATE_TEST_SUITE_P(EveryMethod, SqrtInformationFromHessianTest,
+                         ::testing::Values(SqrtMethod::kEigen, SqrtMethod::kPivotedCholesky,
+                                           SqrtMethod::kPivotedCholeskyOnly),
                          [](const ::testing::TestParamInfo<SqrtMethod>& info) {
-                           return info.param == SqrtMethod::kEigen ? "Eigen" : "PivotedCholesky";
+                           switch (info.param) {
+                             case SqrtMethod::kEigen: return "Eigen";
+                             case SqrtMethod::kPivotedCholesky: return "PivotedCholesky";
+                             case SqrtMethod::kPivotedCholeskyOnly: return "PivotedCholeskyOnly";
+                           }
+                           return "unknown";
                          });
 
 }  // namespace

@@ -18,6 +18,8 @@
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
+#include "vio/marginalization/block_system.h"
+
 namespace vio::marginalization {
 namespace {
 
@@ -529,6 +531,36 @@ TEST(MarginalizeBlocks, AllConstantBlanketGivesNoPrior) {
   EXPECT_TRUE(problem.HasParameterBlock(model.block(k)));
 }
 
+// A window's shape: poses p0..p3, then speed/bias blocks s0..s3 chained by
+// (p_i, s_i, p_i+1, s_i+1) factors, and a prior-like factor tying s0 to every
+// pose. Counting only the poses, a speed/bias block spans the poses its
+// factors touch, not every column up to its right neighbour.
+TEST(BlockSystem, CoupledSpansOverTheCountedBlocksOnly) {
+  LinearModel model(5);
+  std::vector<int> poses, speeds;
+  for (int i = 0; i < 4; ++i) poses.push_back(model.AddVariable(6));
+  for (int i = 0; i < 4; ++i) speeds.push_back(model.AddVariable(9));
+  for (int i = 0; i + 1 < 4; ++i) model.AddFactor({poses[i], speeds[i], poses[i + 1], speeds[i + 1]}, 15);
+  model.AddFactor({speeds[0], poses[0], poses[1], poses[2], poses[3]}, 9);
+  ceres::Problem problem;
+  model.AddAllToProblem(&problem);
+  BlockLayout layout;
+  for (const int v : poses) layout.dense.push_back(model.block(v));
+  for (const int v : speeds) layout.dense.push_back(model.block(v));
+  problem.GetResidualBlocks(&layout.residuals);
+  const BlockSystem system(&problem, layout);
+  using Span = std::pair<int, int>;
+  const std::vector<Span> all = system.CoupledSpans();
+  EXPECT_EQ(all[5], Span(0, 6));  // s1: p0 .. s2
+  EXPECT_EQ(all[4], Span(0, 5));  // s0: p0 .. s1
+  const std::vector<bool> poses_only = {true, true, true, true, false, false, false, false};
+  const std::vector<Span> over_poses = system.CoupledSpans(poses_only);
+  EXPECT_EQ(over_poses[4], Span(0, 3));  // s0: every pose (the prior-like factor)
+  EXPECT_EQ(over_poses[5], Span(0, 2));  // s1: p0 .. p2
+  EXPECT_EQ(over_poses[7], Span(2, 3));
+  EXPECT_EQ(over_poses[1], Span(0, 3));
+}
+
 // Nonlinear factors on poses (q_w_b, p_w_b) with quaternion manifolds.
 
 // r = R(q_w_b)^T (p_w_l - p_w_b) - p_b_l_measured: a landmark seen from a pose.
@@ -655,8 +687,8 @@ class NonlinearPosesTest : public ::testing::Test {
 };
 
 TEST_F(NonlinearPosesTest, PriorAtTheLinearizationPointIsTheoremTwoTwoTwo) {
-  for (const SqrtMethod method : {SqrtMethod::kEigen, SqrtMethod::kPivotedCholesky}) {
-    SCOPED_TRACE(method == SqrtMethod::kEigen ? "kEigen" : "kPivotedCholesky");
+  for (const SqrtMethod method : {SqrtMethod::kEigen, SqrtMethod::kPivotedCholesky, SqrtMethod::kPivotedCholeskyOnly}) {
+    SCOPED_TRACE(static_cast<int>(method));
     MarginalizationOptions options;
     options.sqrt_method = method;
     const MarginalizationResult result = ComputeMarginalization(&problem_, {q0_, p0_}, options);

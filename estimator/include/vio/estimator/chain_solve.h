@@ -24,8 +24,9 @@ namespace vio {
 struct ChainBlock {
   int offset = 0;
   int size = 0;
-  /// H's columns [first_column, end_column) hold every non-zero of the
-  /// block's rows (a superset is fine); -1: not known, all of them.
+  /// Among the columns not in the chain, [first_column, end_column) hold
+  /// every non-zero of the block's rows (a superset is fine); -1: not known,
+  /// all of them.
   int first_column = -1;
   int end_column = -1;
 };
@@ -78,6 +79,8 @@ class ChainSolver {
   template <int N>
   void BackwardSolve(RowMajorMatrix* z);
   void GatherRest(const Eigen::MatrixXd& H, const std::vector<ChainBlock>& chain, int chain_dim);
+  /// x <- S^-1 x, S_ (its upper triangle) factored in place; false when it is not positive definite.
+  bool SolveRest(Eigen::VectorXd* x);
   template <int N>
   void SubtractCoupling();
   const Eigen::MatrixXd& L(int i, int j) const { return below_[i][i - j - 1]; }
@@ -91,7 +94,7 @@ class ChainSolver {
   std::vector<std::vector<Eigen::MatrixXd>> below_;    ///< below_[i][i - j - 1] = L(i, j), j < i in the band
   RowMajorMatrix B_;  ///< H_chain,rest
   RowMajorMatrix Z_;  ///< H_chain,chain^-1 H_chain,rest
-  Eigen::MatrixXd S_;  ///< H_rest,rest - H_rest,chain Z (upper triangle used)
+  Eigen::MatrixXd S_;  ///< H_rest,rest - H_rest,chain Z (upper triangle formed; SolveRest factors it)
   RowMajorMatrix w_;  ///< H_chain,chain^-1 b_chain (one column)
   RowMajorMatrix scratch_;  ///< one row block of a right-hand side
   Eigen::VectorXd dx_rest_;

@@ -260,6 +260,9 @@ class Window {
   std::map<ObservationKey, Observation> observations_;
   std::map<ObservationKey, ceres::ResidualBlockId> anchored_points_;
   std::vector<Prior> priors_;
+  /// Whether the last marginalization's prior had fewer rows than columns
+  /// (Marginalize picks the next square root's factorization by it).
+  bool last_prior_rank_deficient_ = false;
   std::shared_ptr<FirstEstimates> first_estimates_;  ///< model.fej: the held blocks; else null
   Removals removals_;
   WindowHealth health_;

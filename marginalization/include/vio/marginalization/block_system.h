@@ -82,8 +82,10 @@ class BlockSystem {
   int CouplingBandwidth(const std::vector<int>& position) const;
   /// For each dense block, the first and last dense block (by index) the
   /// reduced H couples it to (itself included): outside that span its rows
-  /// of H are zero.
-  std::vector<std::pair<int, int>> CoupledSpans() const;
+  /// of H are zero. With `counted` (one entry per dense block), only the
+  /// counted blocks the reduced H couples it to: outside that span its rows
+  /// are zero in the counted blocks' columns ((d, d) when it couples to none).
+  std::vector<std::pair<int, int>> CoupledSpans(const std::vector<bool>& counted = {}) const;
 
  private:
   struct Impl;

@@ -45,6 +45,12 @@ enum class SqrtMethod {
   /// back to kEigen when the factor does not give H back (H indefinite beyond
   /// round-off).
   kPivotedCholesky,
+  /// kPivotedCholesky without the unpivoted attempt: for an H expected to be
+  /// rank-deficient (a sliding window's marginal usually is when the previous
+  /// one was), where that attempt costs a whole factorization and then fails
+  /// its pivot test. Any H gives the same prior as kPivotedCholesky up to an
+  /// orthogonal transform of its rows.
+  kPivotedCholeskyOnly,
 };
 
 /// Gauss-Newton normal equations of a linearized cost: H = J^T J, b = J^T r.
