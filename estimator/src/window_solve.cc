@@ -34,34 +34,30 @@ std::vector<ceres::ResidualBlockId> Window::ResidualOrder() const {
   return order;
 }
 
-// A state's observations are one range of the map (keyed by state first), a
-// landmark's are listed by it: no walk over every observation.
-std::set<Window::ObservationKey> Window::ObservationKeysOf(const Leaving& leaving) const {
+// A state's residuals are one range of the map (keyed by state first), a
+// landmark's are listed by it (`by`): no walk over every residual.
+template <typename Residuals>
+std::set<Window::ObservationKey> Window::KeysOf(const Residuals& residuals, std::set<StateId> Landmark::*by,
+                                                const Leaving& leaving) const {
   std::set<ObservationKey> keys;
   for (StateId id : leaving.states) {
-    for (auto it = observations_.lower_bound({id, LandmarkId(std::numeric_limits<std::int64_t>::min())});
-         it != observations_.end() && it->first.first == id; ++it) {
+    for (auto it = residuals.lower_bound({id, LandmarkId(std::numeric_limits<std::int64_t>::min())});
+         it != residuals.end() && it->first.first == id; ++it) {
       keys.insert(it->first);
     }
   }
   for (LandmarkId id : leaving.landmarks) {
-    for (StateId from : landmarks_.at(id).observed_from) keys.insert({from, id});
+    for (StateId from : landmarks_.at(id).*by) keys.insert({from, id});
   }
   return keys;
 }
 
+std::set<Window::ObservationKey> Window::ObservationKeysOf(const Leaving& leaving) const {
+  return KeysOf(observations_, &Landmark::observed_from, leaving);
+}
+
 std::set<Window::ObservationKey> Window::AnchoredKeysOf(const Leaving& leaving) const {
-  std::set<ObservationKey> keys;
-  for (StateId id : leaving.states) {
-    for (auto it = anchored_points_.lower_bound({id, LandmarkId(std::numeric_limits<std::int64_t>::min())});
-         it != anchored_points_.end() && it->first.first == id; ++it) {
-      keys.insert(it->first);
-    }
-  }
-  for (LandmarkId id : leaving.landmarks) {
-    for (StateId anchor : landmarks_.at(id).anchored_to) keys.insert({anchor, id});
-  }
-  return keys;
+  return KeysOf(anchored_points_, &Landmark::anchored_to, leaving);
 }
 
 bool Window::Touches(const Prior& prior, const Leaving& leaving) const {

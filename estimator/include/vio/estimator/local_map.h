@@ -13,9 +13,9 @@
 // window it joins the map if it is a keyframe and is dropped otherwise
 // (Window::DropState: its observations go, its two IMU factors merge), so
 // consecutive keyframes stay tied by IMU preintegration over the frames
-// between them. A dropped frame's observations are not lost: each goes,
-// linearized, into a summary per landmark in the body frame of the newest
-// keyframe (AnchoredPointSummary: the frame's pose relative to that keyframe
+// between them. A dropped frame's observations are not lost: each of a
+// landmark the newest keyframe also sees goes, linearized, into a summary per
+// landmark in the body frame of that keyframe (AnchoredPointSummary: the frame's pose relative to that keyframe
 // held as estimated), one 3-row residual per keyframe and landmark
 // (AnchoredPointFactor), so the map keeps what every frame saw at the cost of
 // its keyframes; a state leaving the recent window also joins the map when the
@@ -57,8 +57,9 @@ struct MapKeyframe {
   State state;
   std::map<LandmarkId, Eigen::Vector3d> observations;   ///< z = (u_L, u_R, v) [px]
   std::optional<ImuPreintegration> imu_from_previous;   ///< from the keyframe before it
-  /// The observations of the frames dropped while it was the newest keyframe, per landmark,
-  /// summarized in its body frame (their poses relative to it held as they were estimated).
+  /// The observations of the frames dropped while it was the newest keyframe, of landmarks it
+  /// observes, per landmark, summarized in its body frame (their poses relative to it held as
+  /// they were estimated).
   std::map<LandmarkId, AnchoredPointSummary> anchored;
 };
 
@@ -66,7 +67,6 @@ struct MapKeyframe {
 struct MapLandmark {
   Eigen::Vector3d p_w = Eigen::Vector3d::Zero();  ///< last estimate [m]
   std::set<StateId> keyframes;                    ///< map keyframes observing it
-  std::set<StateId> anchors;                      ///< map keyframes holding a summary of it
 };
 
 /// A frame dropped from the recent window (not a keyframe): its state as it left and the

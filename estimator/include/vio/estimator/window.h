@@ -234,6 +234,11 @@ class Window {
   /// Drops `observations`, and a landmark left unobserved that no prior holds.
   void DropOutlierObservations(const std::vector<ObservationKey>& observations);
   void RemoveStateBookkeeping(StateId id);
+  /// The keys of `residuals` (observations_ or anchored_points_) on what leaves; `by`: the
+  /// landmark's states with such a residual.
+  template <typename Residuals>
+  std::set<ObservationKey> KeysOf(const Residuals& residuals, std::set<StateId> Landmark::*by,
+                                  const Leaving& leaving) const;
   /// The anchored points of the states and landmarks that leave, by ids.
   std::set<ObservationKey> AnchoredKeysOf(const Leaving& leaving) const;
   /// Unobserved and unanchored: a landmark no residual but a prior's holds.
