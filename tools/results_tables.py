@@ -25,7 +25,7 @@ def fmt(value, digits):
 
 
 def estimator_name(policy, window):
-    """batch, SWF(10), or SWF(10) + local map K=8 for the sweep's policy "swf+map8"."""
+    """batch, SWF(10), or SWF(10) + local map K=4 for the sweep's policy "swf+map4"."""
     if policy in ("batch", "ekf", "iekf"):
         return policy
     base, _, keyframes = policy.partition("+map")
