@@ -143,10 +143,14 @@ std::vector<StateId> LocalMap::Slide(Window& window) {
     if (KeyframeLeaving(window) && !window.ObservationsOf(oldest).empty()) {
       JoinMap(oldest, window);
     } else {
+      // The newest keyframe, always live, is the dropped frame's anchor.
       DroppedFrame frame{window.state(oldest), std::nullopt};
-      if (!data_.keyframes.empty()) frame.anchor = LatestState(data_.keyframes.rbegin()->first, window);
+      if (!data_.keyframes.empty()) {
+        const StateId anchor = data_.keyframes.rbegin()->first;
+        frame.anchor = window.state(anchor);
+        Summarize(oldest, anchor, window);
+      }
       data_.dropped.push_back(frame);
-      Summarize(oldest, window);
       window.DropState(oldest);
       dropped.push_back(oldest);
       ++counts_.dropped;
@@ -181,17 +185,15 @@ State FollowAnchor(const DroppedFrame& frame, const State& anchor_now) {
   return out;
 }
 
-void LocalMap::Summarize(StateId frame, Window& window) {
-  if (data_.keyframes.empty()) return;
-  const StateId anchor = data_.keyframes.rbegin()->first;
+void LocalMap::Summarize(StateId frame, StateId anchor, Window& window) {
   MapKeyframe& keyframe = data_.keyframes.at(anchor);
-  const State& a = window.state(anchor);  // the newest keyframe is always live
+  const State& a = window.state(anchor);
   const Eigen::Matrix3d R_w_a = a.q_w_b().toRotationMatrix();
   const State& f = window.state(frame);
   for (const auto& [landmark, z] : window.ObservationsOf(frame)) {
     // Only landmarks the keyframe sees itself: its summaries then number at most its observations
-    // (all of the frame's landmarks made the residuals in the cost grow with the map's density:
-    // 30 against 17 ms per frame after 10 minutes of circling one room, for the same accuracy).
+    // (all of the frame's landmarks made the residuals in the cost grow faster with the map's
+    // density: 30 against 17 ms per frame after 10 minutes of circling one room; docs/local-map.md).
     if (keyframe.observations.count(landmark) == 0) continue;
     if (!(window.WhitenedError(frame, landmark, z) <= gate_sigma_)) continue;
     const Landmark& l = window.landmark(landmark);
@@ -216,11 +218,13 @@ void LocalMap::AddAnchoredPoints(StateId id, Window& window) {
     }
     const State& s = window.state(id);
     const Eigen::Vector3d p_b = s.q_w_b().conjugate() * (window.landmark(landmark).position() - s.p_w_b());
-    if (!((summary.SqrtInformation() * (p_b - summary.mean())).norm() <= gate_sigma_)) {
+    const Eigen::Matrix3d L = summary.SqrtInformation();
+    const Eigen::Vector3d mean = summary.mean();
+    if (!((L * (p_b - mean)).norm() <= gate_sigma_)) {
       ++counts_.gated;
       continue;
     }
-    window.SetAnchoredPoint(id, landmark, summary.mean(), summary.SqrtInformation());
+    window.SetAnchoredPoint(id, landmark, mean, L);
   }
 }
 

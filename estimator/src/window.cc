@@ -6,7 +6,6 @@
 
 #include <glog/logging.h>
 
-#include "vio/estimator/anchored_point_factor.h"
 #include "vio/estimator/imu_factor.h"
 #include "vio/estimator/pose_manifold.h"
 #include "vio/estimator/pose_prior_factor.h"
@@ -171,21 +170,6 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
       loss_.get(), s.pose, it->second.p_w);
   observations_[key] = Observation{z_px, residual};
   it->second.observed_from.insert(state_id);
-}
-
-void Window::SetAnchoredPoint(StateId anchor, LandmarkId landmark_id, const Eigen::Vector3d& p_b_hat,
-                              const Eigen::Matrix3d& sqrt_information) {
-  State& s = state(anchor);
-  auto it = landmarks_.find(landmark_id);
-  CHECK(it != landmarks_.end()) << "anchored point of unknown landmark " << landmark_id.value;
-  const ObservationKey key{anchor, landmark_id};
-  auto existing = anchored_points_.find(key);
-  if (existing != anchored_points_.end()) problem_->RemoveResidualBlock(existing->second);
-  anchored_points_[key] = problem_->AddResidualBlock(
-      WithFirstEstimates(Wrap(new AnchoredPointFactor(p_b_hat, sqrt_information)),
-                         {BlockKey::Pose(anchor), BlockKey::Landmark(landmark_id)}),
-      nullptr, s.pose, it->second.p_w);
-  it->second.anchored_to.insert(anchor);
 }
 
 std::vector<double*> Window::Blocks(const std::vector<StateId>& state_ids,

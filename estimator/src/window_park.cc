@@ -1,5 +1,6 @@
 // Window operations of the local map (local_map.h): a keyframe parked outside
-// the cost and its bookkeeping read back.
+// the cost and its bookkeeping read back, and the summaries of dropped frames'
+// observations anchored on keyframes.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -9,7 +10,24 @@
 
 #include "vio/estimator/window.h"
 
+#include "vio/estimator/anchored_point_factor.h"
+
 namespace vio {
+
+void Window::SetAnchoredPoint(StateId anchor, LandmarkId landmark_id, const Eigen::Vector3d& p_b_hat,
+                              const Eigen::Matrix3d& sqrt_information) {
+  State& s = state(anchor);
+  auto it = landmarks_.find(landmark_id);
+  CHECK(it != landmarks_.end()) << "anchored point of unknown landmark " << landmark_id.value;
+  const ObservationKey key{anchor, landmark_id};
+  auto existing = anchored_points_.find(key);
+  if (existing != anchored_points_.end()) problem_->RemoveResidualBlock(existing->second);
+  anchored_points_[key] = problem_->AddResidualBlock(
+      WithFirstEstimates(Wrap(new AnchoredPointFactor(p_b_hat, sqrt_information)),
+                         {BlockKey::Pose(anchor), BlockKey::Landmark(landmark_id)}),
+      nullptr, s.pose, it->second.p_w);
+  it->second.anchored_to.insert(anchor);
+}
 
 void Window::RemoveState(StateId id) {
   State& s = state(id);

@@ -157,8 +157,8 @@ class LocalMap {
   void SyncLandmarks(const ActiveSet& set, const StereoFrame& frame, StateId state, Window& window);
   void AddKeyframeObservations(Window& window);
   void JoinMap(StateId id, Window& window);
-  /// The observations of `frame`, about to be dropped, into the newest keyframe's summaries.
-  void Summarize(StateId frame, Window& window);
+  /// The observations of `frame`, about to be dropped, into the summaries of `anchor` (live).
+  void Summarize(StateId frame, StateId anchor, Window& window);
   /// Adds a live keyframe's summaries of landmarks in the cost, each within the gate.
   void AddAnchoredPoints(StateId keyframe, Window& window);
   /// A keyframe's latest estimate: the window's while it is live, else the map's.
