@@ -39,6 +39,13 @@
 // needs it: the cost per frame is bounded by the window, 4K + 2 keyframes and
 // their landmarks, whatever the run's length.
 //
+// Culling (IsCullable, CullKeyframe; local_map_culling.cc): a parked keyframe
+// that joined by the link rule, is neither the first nor one of the newest K,
+// and most of whose landmarks 4 other keyframes see leaves the map (its IMU
+// factors merge, its summaries and anchored frames move to other keyframes), so
+// a place circled for minutes does not pile up keyframes and the cost per
+// frame stays flat.
+//
 // Data (LocalMapData) and functions over it; LocalMap applies them to a
 // Window through the window's own operations.
 #include <map>
