@@ -5,7 +5,8 @@ usage: tools/plot_local_map_cost.py --out=PNG LABEL=RUN_DIR [LABEL=RUN_DIR ...]
 
 Reads each RUN_DIR/timing.csv (`vio run`'s per-frame stages and sizes) and draws
 against the time since the first frame: the total ms/frame (wall clock, a 10 s
-running median) and the states and landmarks in the cost (deterministic).
+running median) and the states, landmarks and residual blocks in the cost
+(deterministic; residual blocks a 10 s running mean).
 """
 import argparse
 import csv
@@ -24,16 +25,17 @@ def read(run_dir):
     total = np.array([float(r[5]) for r in rows])
     states = np.array([int(r[7]) for r in rows])
     landmarks = np.array([int(r[8]) for r in rows])
-    return (t - t[0]) * 1e-9, total, states, landmarks
+    residuals = np.array([int(r[10]) for r in rows], dtype=np.float64)
+    return (t - t[0]) * 1e-9, total, states, landmarks, residuals
 
 
-def running_median(t, y, span_s):
+def running(t, y, span_s, statistic):
     out = np.empty_like(y)
     lo = 0
     for i in range(len(t)):
         while t[i] - t[lo] > span_s:
             lo += 1
-        out[i] = np.median(y[lo:i + 1])
+        out[i] = statistic(y[lo:i + 1])
     return out
 
 
@@ -43,18 +45,20 @@ def main():
     parser.add_argument("--title", default="")
     parser.add_argument("runs", nargs="+", help="LABEL=RUN_DIR")
     args = parser.parse_args()
-    fig, (ax, ax_states, ax_landmarks) = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+    fig, (ax, ax_states, ax_landmarks, ax_residuals) = plt.subplots(4, 1, figsize=(8, 10), sharex=True)
     for item in args.runs:
         label, run_dir = item.rsplit("=", 1)
-        t, total, states, landmarks = read(run_dir)
-        ax.plot(t / 60.0, running_median(t, total, 10.0), label=label)
+        t, total, states, landmarks, residuals = read(run_dir)
+        ax.plot(t / 60.0, running(t, total, 10.0, np.median), label=label)
         ax_states.plot(t / 60.0, states, label=label, linewidth=0.6)
         ax_landmarks.plot(t / 60.0, landmarks, label=label, linewidth=0.6)
+        ax_residuals.plot(t / 60.0, running(t, residuals, 10.0, np.mean), label=label)
     ax.set_ylabel("ms/frame, wall\n(10 s running median)")
     ax_states.set_ylabel("states in the cost")
     ax_landmarks.set_ylabel("landmarks in the cost")
-    ax_landmarks.set_xlabel("time [min]")
-    for a in (ax, ax_states, ax_landmarks):
+    ax_residuals.set_ylabel("residual blocks in the cost\n(10 s running mean)")
+    ax_residuals.set_xlabel("time [min]")
+    for a in (ax, ax_states, ax_landmarks, ax_residuals):
         a.set_ylim(bottom=0)
         a.grid(True, alpha=0.3)
     ax.legend()

@@ -16,6 +16,14 @@ void AnchoredPointSummary::Add(const Eigen::Vector3d& p_b0, const Eigen::Vector3
   ++count_;
 }
 
+void AnchoredPointSummary::Absorb(const AnchoredPointSummary& other, const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+  // Each of its residuals e(p_o) = e(R^T (p - t)): Jacobian J R^T, information R H R^T.
+  const Eigen::Matrix3d H = R * other.information_ * R.transpose();
+  information_ += H;
+  information_mean_ += R * other.information_mean_ + H * t;
+  count_ += other.count_;
+}
+
 bool AnchoredPointSummary::Usable() const {
   const Eigen::LLT<Eigen::Matrix3d> llt(information_);
   return count_ > 0 && llt.info() == Eigen::Success && information_.allFinite();

@@ -294,6 +294,7 @@ FrameEstimate Estimator::Estimate(const StereoFrame& frame) const {
   e.num_states = static_cast<int>(window_.states().size());
   e.num_landmarks = static_cast<int>(window_.landmarks().size());
   e.num_observations = static_cast<int>(frame.observations.size());
+  e.num_residuals = window_.num_residual_blocks();
   return e;
 }
 

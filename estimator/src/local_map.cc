@@ -142,6 +142,10 @@ std::vector<StateId> LocalMap::Slide(Window& window) {
     // pose and speed held fixed for the window to lean on.
     if (KeyframeLeaving(window) && !window.ObservationsOf(oldest).empty()) {
       JoinMap(oldest, window);
+      // The keyframe the new one moves out of the newest K, if parked (else when it is parked).
+      auto it = data_.keyframes.rbegin();
+      for (int i = 0; i < options_.local_map_keyframes && it != data_.keyframes.rend(); ++i) ++it;
+      if (it != data_.keyframes.rend()) MaybeCull(it->first);
     } else {
       // The newest keyframe, always live, is the dropped frame's anchor.
       DroppedFrame frame{window.state(oldest), std::nullopt};
@@ -238,6 +242,7 @@ void LocalMap::JoinMap(StateId id, Window& window) {
     l.p_w = window.landmark(landmark).position();
   }
   if (const ImuPreintegration* imu = window.ImuFactorInto(id, nullptr)) keyframe.imu_from_previous = *imu;
+  keyframe.by_link = data_.recent_keyframes.count(id) == 0;
   data_.keyframes[id] = std::move(keyframe);
   data_.live.insert(id);
   ++counts_.keyframes;
@@ -250,7 +255,10 @@ void LocalMap::Apply(const ActiveSet& set, const StereoFrame& frame, StateId sta
   for (StateId id : data_.live) {
     if (!wanted(id)) leaving.push_back(id);
   }
-  for (StateId id : leaving) Park(id, window);
+  for (StateId id : leaving) {
+    Park(id, window);
+    MaybeCull(id);
+  }
   for (const std::set<StateId>* group : {&set.active, &set.fixed}) {
     for (StateId id : *group) {
       if (data_.live.count(id) == 0) Unpark(id, window);
@@ -365,7 +373,7 @@ void LogLocalMapCounts(const LocalMap& map) {
   if (!map.enabled()) return;
   const LocalMapCounts& c = map.counts();
   LOG(INFO) << "local map: " << c.keyframes << " keyframes, " << c.dropped << " frames dropped, " << c.parked
-            << " keyframes parked, " << c.unparked << " brought back, " << c.landmark_returns
+            << " keyframes parked, " << c.culled << " culled, " << c.unparked << " brought back, " << c.landmark_returns
             << " parked landmarks observed again, " << c.gated << " observations beyond the gate not added again; at most "
             << c.most_states << " states in the cost";
 }

@@ -117,5 +117,28 @@ TEST(AnchoredPointSummary, NeedsFullRankInformation) {
   EXPECT_FALSE(summary.Usable());
 }
 
+
+// A summary moved to another frame (p = R p_o + t) is the summary of its observations taken there.
+TEST(AnchoredPointSummary, AbsorbMovesTheObservationsToAnotherFrame) {
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.6, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  const Eigen::Vector3d t(0.3, -1.2, 2.0);
+  AnchoredPointSummary in_o, in_this;
+  in_this.Add(Eigen::Vector3d(0.1, 0.2, 0.3), Eigen::Vector3d(0.5, -0.1, 0.2), Eigen::Matrix3d::Identity());
+  AnchoredPointSummary expected = in_this;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d p_o(1.0 + i, -0.5 * i, 4.0);
+    const Eigen::Vector3d e(0.2 * i, 0.1, -0.3);
+    Eigen::Matrix3d J = Eigen::Matrix3d::Identity();
+    J(0, 2) = 0.1 * i;
+    J(1, 0) = 0.4;
+    in_o.Add(p_o, e, J);
+    expected.Add(R * p_o + t, e, J * R.transpose());
+  }
+  in_this.Absorb(in_o, R, t);
+  EXPECT_EQ(in_this.count(), 4);
+  EXPECT_TRUE(in_this.information().isApprox(expected.information(), 1e-12));
+  EXPECT_TRUE(in_this.mean().isApprox(expected.mean(), 1e-12));
+}
+
 }  // namespace
 }  // namespace vio

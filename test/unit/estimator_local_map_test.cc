@@ -93,6 +93,67 @@ TEST(LocalMap, ActiveSetSelection) {
   EXPECT_EQ(set.fixed, (std::set<StateId>{StateId(0), StateId(30)}));  // 0: most covisible with the window
 }
 
+// A keyframe that joined by the link rule goes when at least the fraction of its landmarks is seen
+// by 4 other keyframes, and only when parked, between two keyframes: the first and the newest stay.
+TEST(LocalMap, RedundantKeyframeIsCulled) {
+  LocalMapData map;
+  AddMapKeyframe(map, 0, 0, 10);     // 0..9
+  AddMapKeyframe(map, 10, 0, 20);    // 0..19: 10..19 seen by it alone
+  AddMapKeyframe(map, 20, 0, 10);    // 0..9, each seen by 0, 10 and 30 too
+  AddMapKeyframe(map, 30, 0, 10);
+  AddMapKeyframe(map, 40, 100, 10);  // newest
+  EXPECT_FALSE(IsRedundant(map, StateId(20), 0.9)) << "3 others";
+  AddMapKeyframe(map, 40, 0, 10);    // and 0..9: 4 others
+  EXPECT_TRUE(IsRedundant(map, StateId(20), 0.9));
+  EXPECT_FALSE(IsRedundant(map, StateId(10), 0.9));  // half of its landmarks: 0..9
+  EXPECT_TRUE(IsRedundant(map, StateId(10), 0.5));
+  EXPECT_FALSE(IsRedundant(map, StateId(20), 0.0)) << "0: never";
+  EXPECT_FALSE(IsCullable(map, StateId(20), 0.9, 1)) << "no IMU factors yet";
+  ImuPreintegration step(ImuBias{}, ImuCalibration());
+  step.Integrate(0.5, Eigen::Vector3d(0, 0, 0.1), Eigen::Vector3d(0, 0, 9.81));
+  for (int id : {10, 20, 30, 40}) map.keyframes.at(StateId(id)).imu_from_previous = step;
+  for (int id : {0, 10, 20, 30, 40}) map.keyframes.at(StateId(id)).state.id = StateId(id);
+  map.keyframes.at(StateId(10)).state.SetPose(Eigen::Vector3d(1, 0, 0), Eigen::Quaterniond::Identity());
+  map.keyframes.at(StateId(20)).state.SetPose(
+      Eigen::Vector3d(2, 1, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ())));
+  map.live.insert(StateId(20));
+  EXPECT_FALSE(IsCullable(map, StateId(20), 0.9, 1)) << "live";
+  map.live.clear();
+  EXPECT_FALSE(IsCullable(map, StateId(40), 0.9, 1)) << "the newest keyframe stays";
+  EXPECT_FALSE(IsCullable(map, StateId(20), 0.9, 1)) << "a new view (IsKeyframe) stays";
+  for (int id : {0, 10, 20, 30, 40}) map.keyframes.at(StateId(id)).by_link = true;
+  EXPECT_FALSE(IsCullable(map, StateId(0), 0.9, 1)) << "the first keyframe stays";
+  EXPECT_TRUE(IsCullable(map, StateId(20), 0.9, 1));
+  EXPECT_FALSE(IsCullable(map, StateId(20), 0.9, 3)) << "one of the 3 newest";
+  EXPECT_FALSE(IsCullable(map, StateId(10), 0.9, 1));
+  // A frame dropped while 20 was the newest keyframe keeps its pose (it follows 10 from now on).
+  DroppedFrame frame;
+  frame.state.SetPose(Eigen::Vector3d(2.5, 1.2, 0.1), Eigen::Quaterniond::Identity());
+  frame.anchor = map.keyframes.at(StateId(20)).state;
+  map.dropped.push_back(frame);
+  const Eigen::Vector3d before = FollowAnchor(frame, map.keyframes.at(StateId(20)).state).p_w_b();
+  // Its summary of landmark 3 moves to the parked keyframe nearest in time that sees it: 10, as 30
+  // is live (a point 2 m ahead of 20, at (2, 1, 2) in the world: (1, 1, 2) from 10).
+  map.keyframes.at(StateId(20)).anchored[LandmarkId(3)].Add(Eigen::Vector3d(0, 0, 2), Eigen::Vector3d::Zero(),
+                                                            Eigen::Matrix3d::Identity());
+  map.live.insert(StateId(30));
+  CullKeyframe(map, StateId(20));
+  map.live.clear();
+  ASSERT_EQ(map.keyframes.at(StateId(10)).anchored.count(LandmarkId(3)), 1u);
+  EXPECT_TRUE(map.keyframes.at(StateId(10)).anchored.at(LandmarkId(3)).mean().isApprox(Eigen::Vector3d(1, 1, 2), 1e-12));
+  EXPECT_EQ(map.keyframes.count(StateId(20)), 0u);
+  EXPECT_EQ(map.landmarks.at(LandmarkId(3)).keyframes, (std::set<StateId>{StateId(0), StateId(10), StateId(30), StateId(40)}));
+  const ImuPreintegration& merged = *map.keyframes.at(StateId(30)).imu_from_previous;
+  EXPECT_DOUBLE_EQ(merged.delta_time_s(), 1.0) << "its two IMU factors merged into one";
+  EXPECT_EQ(merged.num_steps(), 2);
+  ASSERT_EQ(map.dropped.size(), 2u);
+  EXPECT_EQ(map.dropped[0].anchor->id, StateId(10));
+  EXPECT_TRUE(FollowAnchor(map.dropped[0], map.keyframes.at(StateId(10)).state).p_w_b().isApprox(before, 1e-12));
+  EXPECT_EQ(map.dropped[1].anchor->id, StateId(10)) << "the culled keyframe follows the one before it";
+  EXPECT_TRUE(map.dropped[1].state.p_w_b().isApprox(Eigen::Vector3d(2, 1, 0), 1e-12));
+  EXPECT_FALSE(IsRedundant(map, StateId(30), 0.9)) << "0..9 seen by 3 others now: 0, 10 and 40";
+}
+
 // ---- whole runs on the simulator's room --------------------------------------
 
 // The simulator's flight period (its FlightInRoom for the default room).

@@ -94,13 +94,13 @@ void RunOutput::WriteTrajectory() const { WriteTumTrajectory(trajectory_, dir_ +
 void RunOutput::WriteTiming() const {
   std::ofstream out = OpenForWriting(dir_ + "/timing.csv");
   out << "#timestamp [ns],propagate [ms],build [ms],solve [ms],marginalize [ms],total [ms],"
-         "solver_iterations,states,landmarks,observations\n";
+         "solver_iterations,states,landmarks,observations,residual blocks\n";
   for (const FrameEstimate& f : frames_) {
     const PolicyTiming& p = f.timing.policy;
     out << f.t_ns << "," << JsonNumber(f.timing.propagate_ms) << "," << JsonNumber(p.build_ms) << ","
         << JsonNumber(p.solve_ms) << "," << JsonNumber(p.marginalize_ms) << "," << JsonNumber(f.timing.total_ms) << ","
         << p.solver_iterations << "," << f.num_states << "," << f.num_landmarks << "," << f.num_observations
-        << "\n";
+        << "," << f.num_residuals << "\n";
   }
 }
 

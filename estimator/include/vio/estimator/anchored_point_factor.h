@@ -28,6 +28,8 @@ class AnchoredPointSummary {
  public:
   /// One whitened residual e0 at p_b0 with de/dp_b = J.
   void Add(const Eigen::Vector3d& p_b0, const Eigen::Vector3d& e0, const Eigen::Matrix3d& J);
+  /// Adds `other`, a summary of the same point in a frame o with p = R p_o + t in this one.
+  void Absorb(const AnchoredPointSummary& other, const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
   int count() const { return count_; }
   const Eigen::Matrix3d& information() const { return information_; }
   /// False when the information is not positive definite (no usable mean).

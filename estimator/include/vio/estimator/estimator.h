@@ -37,6 +37,7 @@ struct FrameEstimate {
   int num_states = 0;
   int num_landmarks = 0;
   int num_observations = 0;   ///< stereo observations in the frame
+  int num_residuals = 0;      ///< residual blocks in the cost after the frame's update
   FrameTiming timing;
 };
 

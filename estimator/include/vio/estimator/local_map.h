@@ -39,6 +39,13 @@
 // needs it: the cost per frame is bounded by the window, 4K + 2 keyframes and
 // their landmarks, whatever the run's length.
 //
+// Culling (IsCullable, CullKeyframe; local_map_culling.cc): a parked keyframe
+// that joined by the link rule, is neither the first nor one of the newest K,
+// and most of whose landmarks 4 other keyframes see leaves the map (its IMU
+// factors merge, its summaries and anchored frames move to other keyframes), so
+// a place circled for minutes does not pile up keyframes and the cost per
+// frame stays flat.
+//
 // Data (LocalMapData) and functions over it; LocalMap applies them to a
 // Window through the window's own operations.
 #include <map>
@@ -61,6 +68,9 @@ struct MapKeyframe {
   /// observes, per landmark, summarized in its body frame (their poses relative to it held as
   /// they were estimated).
   std::map<LandmarkId, AnchoredPointSummary> anchored;
+  /// Joined by the IMU link rule (local_map_max_link_s), not as a new view (IsKeyframe): only such
+  /// keyframes are culled.
+  bool by_link = false;
 };
 
 /// A landmark seen from a map keyframe.
@@ -107,12 +117,27 @@ std::map<StateId, int> SharedLandmarks(const LocalMapData& map, const std::set<L
 /// The active set for `keyframes` = K (see the file comment); empty when the map is.
 ActiveSet SelectActiveSet(const LocalMapData& map, int keyframes);
 
+/// True when at least `fraction` of the keyframe's landmarks is seen by 3 other map keyframes
+/// (ORB-SLAM's redundancy); never when `fraction` <= 0.
+bool IsRedundant(const LocalMapData& map, StateId id, double fraction);
+
+/// True when `id` is a map keyframe that can leave the map: joined by the link rule, redundant,
+/// parked, not the first and not one of the `kept_newest` newest (>= 1: an IMU factor into it and
+/// out of it; the chain the recent window leans on keeps its short links).
+bool IsCullable(const LocalMapData& map, StateId id, double fraction, int kept_newest);
+
+/// Removes a cullable keyframe from the map: its two IMU factors merge into the next keyframe's,
+/// the frames anchored on it (and its own last estimate) follow the keyframe before it, its
+/// summaries are dropped.
+void CullKeyframe(LocalMapData& map, StateId id);
+
 /// Counts over a run.
 struct LocalMapCounts {
   int keyframes = 0;         ///< states that joined the map
   int dropped = 0;           ///< recent states dropped (not keyframes)
   int parked = 0;            ///< keyframes parked outside the cost
   int unparked = 0;          ///< keyframes brought back
+  int culled = 0;            ///< keyframes culled from the map (redundant)
   int landmark_returns = 0;  ///< parked landmarks brought back because a new frame observes them
   int gated = 0;             ///< observations the map did not add again: predicted beyond the gate
   int most_states = 0;       ///< largest number of states in the cost [count]
@@ -157,6 +182,8 @@ class LocalMap {
   void SyncLandmarks(const ActiveSet& set, const StereoFrame& frame, StateId state, Window& window);
   void AddKeyframeObservations(Window& window);
   void JoinMap(StateId id, Window& window);
+  /// Culls `id` when it is cullable (IsCullable, the newest K kept).
+  void MaybeCull(StateId id);
   /// The observations of `frame`, about to be dropped, into the summaries of `anchor` (live).
   void Summarize(StateId frame, StateId anchor, Window& window);
   /// Adds a live keyframe's summaries of landmarks in the cost, each within the gate.

@@ -179,6 +179,7 @@ class Window {
   int num_priors() const { return static_cast<int>(priors_.size()); }
   const WindowHealth& health() const { return health_; }
   ceres::Problem& problem() { return *problem_; }
+  int num_residual_blocks() const { return problem_->NumResidualBlocks(); }
   /// The Gauss-Newton column layout: variable blocks in id order, states
   /// then landmarks tied by a prior (dense); the other landmarks eliminated.
   GaussNewtonLayout Layout() const;
