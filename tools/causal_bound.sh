@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# The best an online estimator can do (docs/local-map.md, "Online against
-# batch"): batch solved over the frames up to T, for T = START, START+STEP, ...
-# to the end of the recording, keeping only the pose of the frame at T. That
-# pose is the maximum a posteriori estimate from every measurement up to T,
-# which no causal estimator (one that writes frame T's pose at frame T) can
-# beat in expectation. Each cut is the dataset's own files truncated at T (the
-# same measurements as the whole recording), so it applies to any EuRoC ASL
-# folder with features0 or images.
+# The exact solve of the data up to each frame (docs/local-map.md, "Online
+# against batch"): batch solved over the frames up to T, for T = START,
+# START+STEP, ... to the end of the recording, keeping only the pose of the
+# frame at T. That pose is the maximum a posteriori estimate from every
+# measurement up to T: the reference for an online estimator (one that writes
+# frame T's pose at frame T), as batch's final solve is for a smoother. Each
+# cut is the dataset's own files truncated at T (the same measurements as the
+# whole recording): any EuRoC ASL folder with features0 or images.
 #   tools/causal_bound.sh DATASET OUT [STEP_S] [TRAJECTORY...]
 # Writes OUT/causal.txt (TUM, one pose per cut; resumable) and prints ATE
 # (SE3) of it and, at the same timestamps, of each TRAJECTORY given (e.g. the
@@ -17,7 +17,7 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 vio="${VIO:-${BUILD_DIR:-$root/build}/bin/vio}"
 config="${CONFIG:-$root/config/euroc_stereo.yaml}"
-if [ $# -lt 2 ]; then sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 2; fi
+if [ $# -lt 2 ]; then sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 2; fi
 dataset="$(cd "$1" && pwd)"; out="$2"; step="${3:-2}"; shift $(( $# < 3 ? $# : 3 ))
 [ -f "$dataset/mav0/cam0/data.csv" ] || { echo "causal_bound: $dataset has no mav0/cam0/data.csv" >&2; exit 2; }
 mkdir -p "$out"; out="$(cd "$out" && pwd)"

@@ -36,16 +36,8 @@ run() {  # SEQ START POLICY [SUFFIX FLAGS...]
   nice "$vio" run --dataset="$out/data/$1_$2" --config="$config" ${policy_flags[$3]} "${@:5}" --output_dir="$dir" \
     >"$dir.log" 2>&1 || true
 }
-queue() {  # at most JOBS runs at once
-  "$@" &
-  jobs+=($!)
-  if [ "${#jobs[@]}" -ge "${JOBS:-2}" ]; then wait "${jobs[0]}"; jobs=("${jobs[@]:1}"); fi
-}
-ate() {  # TRAJECTORY GROUNDTRUTH -> ATE rmse [m] (se3)
-  "$vio" eval --estimate="$1" --groundtruth="$2" --alignment=se3 --json="$1.se3.json" >/dev/null 2>&1 &&
-    python3 -c "import json,sys; print('%.4f' % json.load(open(sys.argv[1]))['ate']['rmse_m'])" "$1.se3.json" ||
-    echo nan
-}
+# shellcheck source=tools/table_lib.sh
+source "$root/tools/table_lib.sh"   # queue, ate
 
 mkdir -p "$out/runs"
 jobs=()
