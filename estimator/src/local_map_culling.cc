@@ -1,5 +1,5 @@
 // Keyframe culling of the local map (local_map.h), as ORB-SLAM's local mapping
-// culls: a keyframe most of whose landmarks at least three other keyframes see
+// culls: a keyframe most of whose landmarks at least four other keyframes see (ORB-SLAM: three)
 // adds little but residuals to every solve it is live in. When it leaves the
 // cost it leaves the map: its two IMU factors merge into one (the chain stays
 // whole, as Window::DropState merges a dropped frame's), the frames anchored
