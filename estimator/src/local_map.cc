@@ -143,9 +143,7 @@ std::vector<StateId> LocalMap::Slide(Window& window) {
     if (KeyframeLeaving(window) && !window.ObservationsOf(oldest).empty()) {
       JoinMap(oldest, window);
       // The keyframe the new one moves out of the newest K, if parked (else when it is parked).
-      auto it = data_.keyframes.rbegin();
-      for (int i = 0; i < options_.local_map_keyframes && it != data_.keyframes.rend(); ++i) ++it;
-      if (it != data_.keyframes.rend()) MaybeCull(it->first);
+      if (const std::optional<StateId> id = NewestBeyond(data_, options_.local_map_keyframes)) MaybeCull(*id);
     } else {
       // The newest keyframe, always live, is the dropped frame's anchor.
       DroppedFrame frame{window.state(oldest), std::nullopt};

@@ -62,18 +62,19 @@ bool CanLeaveMap(const LocalMapData& map, StateId id) {
   return map.live.count(id) == 0 && it->second.imu_from_previous && std::next(it)->second.imu_from_previous;
 }
 
-bool AmongNewest(const LocalMapData& map, StateId id, int count) {
-  int seen = 0;
-  for (auto it = map.keyframes.rbegin(); it != map.keyframes.rend() && seen < count; ++it, ++seen) {
-    if (it->first == id) return true;
-  }
-  return false;
-}
-
 }  // namespace
 
+std::optional<StateId> NewestBeyond(const LocalMapData& map, int count) {
+  auto it = map.keyframes.rbegin();
+  for (int i = 0; i < count && it != map.keyframes.rend(); ++i) ++it;
+  if (it == map.keyframes.rend()) return std::nullopt;
+  return it->first;
+}
+
 bool IsCullable(const LocalMapData& map, StateId id, double fraction, int kept_newest) {
-  return CanLeaveMap(map, id) && !AmongNewest(map, id, kept_newest) && map.keyframes.at(id).by_link &&
+  const std::optional<StateId> newest_not_kept = NewestBeyond(map, kept_newest);
+  const bool among_newest = !newest_not_kept || id.value > newest_not_kept->value;
+  return CanLeaveMap(map, id) && !among_newest && map.keyframes.at(id).by_link &&
          IsRedundant(map, id, fraction);
 }
 

@@ -117,7 +117,7 @@ struct LocalMapOptions {
   int local_map_keyframes = 0;     ///< K: keyframes solved with the recent window [count]; 0 = off
   double local_map_overlap = 0.7;  ///< new keyframe below this landmark fraction shared with the reference keyframe []
   double local_map_max_link_s = 3.0;  ///< longest IMU factor between keyframes, else the frame is one [s]
-  double local_map_cull = 0.9;  ///< a parked keyframe goes when this fraction of its landmarks is seen by 3 others []
+  double local_map_cull = 0.9;  ///< a parked keyframe goes when this fraction of its landmarks is seen by 4 others []
 
   template <class V>
   void Visit(V& v) {
@@ -136,7 +136,7 @@ struct LocalMapOptions {
       Positive());
     v("local_map_cull", local_map_cull,
       "local map: a keyframe leaving the cost (not the first or the newest) is culled when at least this fraction of "
-      "its landmarks is seen by 3 other keyframes (its IMU factors merge into one, the frames anchored on it follow "
+      "its landmarks is seen by 4 other keyframes (its IMU factors merge into one, the frames anchored on it follow "
       "the keyframe before it, its summaries the nearest parked keyframe seeing their landmark); 0 = never []",
       Between(0, 1));
   }

@@ -117,8 +117,8 @@ std::map<StateId, int> SharedLandmarks(const LocalMapData& map, const std::set<L
 /// The active set for `keyframes` = K (see the file comment); empty when the map is.
 ActiveSet SelectActiveSet(const LocalMapData& map, int keyframes);
 
-/// True when at least `fraction` of the keyframe's landmarks is seen by 3 other map keyframes
-/// (ORB-SLAM's redundancy); never when `fraction` <= 0.
+/// True when at least `fraction` of the keyframe's landmarks is seen by 4 other map keyframes
+/// (ORB-SLAM's redundancy, which asks 3); never when `fraction` <= 0.
 bool IsRedundant(const LocalMapData& map, StateId id, double fraction);
 
 /// True when `id` is a map keyframe that can leave the map: joined by the link rule, redundant,
@@ -126,9 +126,12 @@ bool IsRedundant(const LocalMapData& map, StateId id, double fraction);
 /// out of it; the chain the recent window leans on keeps its short links).
 bool IsCullable(const LocalMapData& map, StateId id, double fraction, int kept_newest);
 
+/// The newest map keyframe that is not one of the `count` newest, if any.
+std::optional<StateId> NewestBeyond(const LocalMapData& map, int count);
+
 /// Removes a cullable keyframe from the map: its two IMU factors merge into the next keyframe's,
 /// the frames anchored on it (and its own last estimate) follow the keyframe before it, its
-/// summaries are dropped.
+/// summaries move to the parked keyframe nearest in time observing their landmark.
 void CullKeyframe(LocalMapData& map, StateId id);
 
 /// Counts over a run.
