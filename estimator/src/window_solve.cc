@@ -2,6 +2,7 @@
 // layout by ids, the exact GN path (gauss_newton.h) and the Levenberg-Marquardt
 // path through ceres::Solve with id-ordered elimination groups.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -16,6 +17,36 @@
 #include "vio/estimator/window.h"
 
 namespace vio {
+namespace {
+
+// The caller's SolveControl inside ceres::Solve: progress after each
+// iteration, and a stop request that ends the solve at the iterate reached.
+class SolveControlCallback final : public ceres::IterationCallback {
+ public:
+  SolveControlCallback(const SolveControl& control, int max_iterations)
+      : control_(control), max_iterations_(max_iterations) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (summary.iteration == 0) initial_cost_ = summary.cost;
+    control_.Report({summary.iteration, max_iterations_, initial_cost_, summary.cost,
+                     summary.cumulative_time_in_seconds});
+    if (!control_.StopRequested()) return ceres::SOLVER_CONTINUE;
+    stopped_ = true;
+    return ceres::SOLVER_TERMINATE_SUCCESSFULLY;  // keeps the iterate reached
+  }
+  bool stopped() const { return stopped_; }
+
+ private:
+  const SolveControl& control_;
+  int max_iterations_;
+  double initial_cost_ = 0;
+  bool stopped_ = false;
+};
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
 
 std::set<const double*> Window::BlocksInPriors() const {
   std::set<const double*> in_prior;
@@ -216,7 +247,13 @@ SolveReport Window::GaussNewton(int max_steps, bool until_converged, const Solve
   };
   lay_out();
   GaussNewtonSolver* solver = gauss_newton_.get();
+  const auto start = std::chrono::steady_clock::now();
   for (int k = 0; k < max_steps; ++k) {
+    if (solve_control_.StopRequested()) {
+      report.stopped = true;
+      ++health_.stopped_solves;
+      break;
+    }
     const GaussNewtonStep step = solver->Step();
     if (k == 0) report.initial_cost = report.final_cost = step.cost;
     if (!step.ok) {
@@ -239,6 +276,7 @@ SolveReport Window::GaussNewton(int max_steps, bool until_converged, const Solve
     }
     ++report.iterations;
     report.final_cost = cost;
+    solve_control_.Report({report.iterations, max_steps, report.initial_cost, cost, SecondsSince(start)});
     VLOG(2) << "gn step " << k << ": cost " << step.cost << " -> " << cost << ", |dx| " << step.step_norm;
     const bool small_change = std::abs(step.cost - cost) <= options.function_tolerance * step.cost;
     const bool small_step =
@@ -258,6 +296,8 @@ SolveReport Window::LevenbergMarquardt(const ceres::Solver::Options& base, const
   solver.num_threads = options.num_threads;
   solver.minimizer_progress_to_stdout = false;
   solver.logging_type = ceres::SILENT;
+  SolveControlCallback control(solve_control_, solver.max_num_iterations);
+  solver.callbacks.push_back(&control);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, problem_.get(), &summary);
   SolveReport report;
@@ -266,6 +306,8 @@ SolveReport Window::LevenbergMarquardt(const ceres::Solver::Options& base, const
   report.final_cost = summary.final_cost;
   report.usable = summary.IsSolutionUsable();
   report.converged = summary.termination_type == ceres::CONVERGENCE;
+  report.stopped = control.stopped();
+  if (report.stopped) ++health_.stopped_solves;
   if (!report.usable) ++health_.failed_solves;
   return report;
 }

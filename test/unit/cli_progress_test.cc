@@ -28,5 +28,21 @@ TEST(ProgressBar, PrintsNothingWhenNotATerminal) {
   EXPECT_TRUE(out.str().empty());
 }
 
+// A long solve's note follows the count, and a shorter line blanks what the longer one left.
+TEST(ProgressBar, DrawsANoteAndClearsIt) {
+  std::ostringstream out;
+  {
+    ProgressBar bar(10, "frames", &out, /*enabled=*/true);
+    bar.SetNote("final solve: iteration 3/20, cost 1.5e+02");
+    EXPECT_NE(out.str().find("0/10 frames 0.0s  final solve: iteration 3/20, cost 1.5e+02"), std::string::npos)
+        << out.str();
+    const size_t with_note = out.str().size() - out.str().rfind('\r');
+    bar.SetNote("");
+    const size_t without_note = out.str().size() - out.str().rfind('\r');
+    EXPECT_EQ(without_note, with_note) << "padded over the note";
+    EXPECT_EQ(out.str().find("  final", out.str().rfind('\r')), std::string::npos);
+  }
+}
+
 }  // namespace
 }  // namespace vio::tools

@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "vio/cli/run.h"
+#include "vio/cli/stop_signal.h"
 
 DEFINE_string(dataset, "", "EuRoC ASL dataset folder (holding mav0/) with features0/data.csv or images");
 DEFINE_bool(output_covariance, false,
@@ -40,6 +41,8 @@ int RunMain(const std::vector<std::string>& args) {
   request.output_covariance = FLAGS_output_covariance;
   request.output_observations = FLAGS_output_observations;
   request.trajectory = FLAGS_trajectory;
+  InstallStopSignalHandlers();
+  request.stop_signal = &StopSignal;
   const RunResult result = RunDataset(request);
   std::cout << "status " << result.status << ": " << result.frames_estimated << "/" << result.frames
             << " frames, " << result.ms_per_frame << " ms per frame, " << result.real_time_factor
@@ -47,6 +50,7 @@ int RunMain(const std::vector<std::string>& args) {
   if (result.evaluation) std::cout << ToText(*result.evaluation);
   std::cout << "results in " << request.output_dir << "\n";
   for (const std::string& problem : result.problems) std::cerr << "vio run: " << problem << "\n";
+  if (result.stop_signal != 0) return InterruptedExitCode(result.stop_signal);
   return result.status == "ok" ? 0 : 1;
 }
 

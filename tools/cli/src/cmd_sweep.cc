@@ -10,6 +10,7 @@
 #include <gflags/gflags.h>
 
 #include "commands.h"
+#include "vio/cli/stop_signal.h"
 #include "vio/sweep/sweep.h"
 
 DEFINE_string(datasets, "", "EuRoC ASL dataset folders, comma separated; a run is filed under the folder's name");
@@ -174,6 +175,12 @@ int Sweep(const SweepRequest& request) {
   } else {
     results = RunSweep(request, std::cout);
   }
+  if (const int signal = StopSignal()) {
+    std::cout << "sweep stopped by a signal: the stopped and unstarted runs have no `done` marker; the same "
+                 "command resumes the sweep (results and plots are not written)"
+              << std::endl;
+    return InterruptedExitCode(signal);
+  }
   WriteResults(request, results);
   if (FLAGS_plots) {
     const std::string script = FLAGS_plot_script.empty() ? FindPlotScript(request.vio_binary) : FLAGS_plot_script;
@@ -201,6 +208,8 @@ int SweepMain(const std::vector<std::string>& args) {
     PrintJobsHelp(path, PlanSweep(request).size());
     return 0;
   }
+  InstallStopSignalHandlers();
+  request.stop_signal = &StopSignal;
   return Sweep(request);
 }
 

@@ -40,6 +40,21 @@ void ProgressBar::Finish() {
   finished_ = true;
 }
 
+void ProgressBar::Stop() {
+  if (!enabled_ || finished_) return;
+  note_.clear();
+  Draw();
+  *out_ << "\n" << std::flush;
+  finished_ = true;
+}
+
+void ProgressBar::SetNote(std::string note) {
+  note_ = std::move(note);
+  if (!enabled_ || finished_) return;
+  last_draw_ = std::chrono::steady_clock::now();
+  Draw();
+}
+
 void ProgressBar::Draw() {
   constexpr int kWidth = 30;
   const double fraction = static_cast<double>(done_) / static_cast<double>(total_);
@@ -50,7 +65,12 @@ void ProgressBar::Draw() {
   std::snprintf(line, sizeof(line), "\r[%-*s] %3d%% %lld/%lld %s %.1fs", kWidth,
                 std::string(filled, '#').c_str(), static_cast<int>(fraction * 100.0),
                 static_cast<long long>(done_), static_cast<long long>(total_), unit_.c_str(), elapsed_s);
-  *out_ << line << std::flush;
+  std::string text = line;
+  if (!note_.empty()) text += "  " + note_;
+  const size_t length = text.size();
+  if (length < drawn_length_) text.append(drawn_length_ - length, ' ');
+  drawn_length_ = length;
+  *out_ << text << std::flush;
 }
 
 }  // namespace vio::tools

@@ -12,6 +12,7 @@
 
 #include <glog/logging.h>
 
+#include "run_control.h"
 #include "run_output.h"
 #include "vio/estimator/estimator.h"
 #include "vio/frontend/stereo_rectifier.h"
@@ -133,6 +134,18 @@ void StopAt(size_t k, size_t num_frames, const std::string& status, const std::s
   result->health.frames_after_stop = static_cast<int>(num_frames - k);
 }
 
+// Ends the loop at frame k (not estimated) because `signal` asked the run to stop.
+void Interrupt(size_t k, size_t num_frames, int signal, RunResult* result) {
+  result->status = "interrupted";
+  result->stop_signal = signal;
+  result->health.frames_after_stop = static_cast<int>(num_frames - k);
+  const std::string message = "interrupted by " + SignalName(signal) + " at frame " + std::to_string(k) + " of " +
+                              std::to_string(num_frames) + ": the " + std::to_string(result->frames_estimated) +
+                              " frames estimated until then are written";
+  LOG(WARNING) << message;
+  result->problems.push_back(message);
+}
+
 // Frame intervals longer than 1.5 median intervals: missing frames.
 void CountFrameGaps(const FrameSource& source, RunResult* result) {
   std::vector<Timestamp> intervals;
@@ -170,11 +183,10 @@ void AddEarlierEstimates(Estimator& estimator, Timestamp first_covered_ns, Times
 // The frame loop: IMU, (ground-truth start), front end, estimator, output.
 // Bad data mid-run ends the loop with a status; what was estimated is kept.
 // `observations` (null: none written) receives every frame the estimator is given.
+// A stop request ends it before the next frame, or (a solve cut short) drops the frame in hand.
 void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, FrameSource& source,
-                    Estimator& estimator, RunOutput& output, ObservationsCsvWriter* observations, RunResult* result) {
-  const auto num_frames = static_cast<std::int64_t>(source.size());
-  ProgressBar progress = request.show_progress ? ProgressBar(num_frames, "frames")
-                                               : ProgressBar(num_frames, "frames", nullptr, false);
+                    Estimator& estimator, RunOutput& output, ObservationsCsvWriter* observations,
+                    ProgressBar& progress, RunResult* result) {
   const bool init_from_gt = request.config.estimator.init.init == "groundtruth";
   ImuCursor imu{dataset, request.config.estimator.model.max_imu_gap_s};
   Timestamp first_covered_ns = -1;  // the first frame the IMU covers
@@ -183,6 +195,10 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
     if (dataset.imu.empty() || t_ns < dataset.imu.front().t_ns) continue;  // counted by ReportFramesOutsideImu
     if (t_ns > dataset.imu.back().t_ns) break;
     if (first_covered_ns < 0) first_covered_ns = t_ns;
+    if (const int signal = StopSignalOf(request)) {
+      Interrupt(k, source.size(), signal, result);
+      break;
+    }
     try {
       if (auto gap = imu.FeedUpTo(t_ns, result->frames_estimated > 0, &estimator)) {
         StopAt(k, source.size(), "imu_gap", *gap, result);
@@ -201,6 +217,10 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
       const StereoFrame frame = source.Frame(k, estimator);
       if (observations != nullptr) observations->Add(frame);
       const FrameEstimate estimate = estimator.ProcessFrame(frame);
+      if (estimator.window().health().stopped_solves > 0) {  // its solve was cut short: not written
+        Interrupt(k, source.size(), StopSignalOf(request), result);
+        break;
+      }
       progress.Update(static_cast<std::int64_t>(k + 1));
       if (!estimate.initialized) {
         ++result->health.frames_waiting_init;
@@ -229,13 +249,29 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
       break;
     }
   }
-  progress.Finish();
 }
 
-// The offline policy's final estimates replace the per-frame ones.
-void FinishEstimates(Estimator& estimator, RunOutput& output, RunResult* result) {
+// The offline policy's final estimates replace the per-frame ones. A final
+// solve stopped by a signal keeps the iterate it reached (status interrupted).
+void FinishEstimates(const RunRequest& request, Estimator& estimator, RunOutput& output,
+                     const SolveProgressLog& solve_log, RunResult* result) {
   try {
-    output.ReplaceEstimates(estimator.Finish());
+    const std::vector<FrameEstimate> final_estimates = estimator.Finish();
+    output.ReplaceEstimates(final_estimates);
+    if (!final_estimates.empty()) result->trajectory = "final";
+    if (estimator.window().health().stopped_solves == 0) return;
+    result->status = "interrupted";
+    result->stop_signal = StopSignalOf(request);
+    std::ostringstream message;
+    message << "interrupted by " << SignalName(result->stop_signal)
+            << " in the final solve: trajectory.txt holds the iterate it had reached";
+    if (const std::optional<SolveProgress>& last = solve_log.last()) {
+      message << " (iteration " << last->iteration << " of " << last->max_iterations << ", cost "
+              << last->initial_cost << " -> " << last->cost << ")";
+    }
+    message << ", not its converged solution";
+    LOG(WARNING) << message.str();
+    result->problems.push_back(message.str());
   } catch (const std::exception& e) {
     const std::string message = std::string("final solve: ") + e.what() + " (the per-frame estimates are kept)";
     LOG(ERROR) << message;
@@ -361,6 +397,12 @@ RunResult RunDataset(const RunRequest& requested) {
   Estimator estimator(request.config.estimator, dataset.imu_calibration, rectifier.rectified());
   RunOutput output(request.output_dir);
   RunResult result;
+  result.trajectory = request.trajectory;
+  const auto num_frames = static_cast<std::int64_t>(source->size());
+  ProgressBar progress = request.show_progress ? ProgressBar(num_frames, "frames")
+                                               : ProgressBar(num_frames, "frames", nullptr, false);
+  SolveProgressLog solve_log(&progress, request.show_solve_progress);
+  estimator.SetSolveControl(MakeSolveControl(request, &solve_log));
   result.frames = static_cast<int>(source->size());
   if (source->size() > 0) {
     result.dataset_duration_s = NanosToSeconds(source->time(source->size() - 1) - source->time(0));
@@ -369,12 +411,21 @@ RunResult RunDataset(const RunRequest& requested) {
   const auto start = std::chrono::steady_clock::now();
   std::optional<ObservationsCsvWriter> observations;
   if (request.output_observations) observations.emplace(request.output_dir + "/observations.csv");
-  EstimateFrames(request, dataset, *source, estimator, output, observations ? &*observations : nullptr, &result);
+  EstimateFrames(request, dataset, *source, estimator, output, observations ? &*observations : nullptr, progress,
+                 &result);
   if (observations) observations->Close();
   result.tracking = estimator.tracking();
   // Every frame's state as last estimated, whether the run finished or stopped.
   if (request.trajectory == "smoothed") output.ReplaceEstimates(estimator.LastEstimates());
-  if (result.status == "ok") FinishEstimates(estimator, output, &result);
+  if (result.status == "ok") {
+    solve_log.SetPhase("final solve");
+    FinishEstimates(request, estimator, output, solve_log, &result);
+  }
+  if (result.status == "interrupted") {
+    progress.Stop();
+  } else {
+    progress.Finish();
+  }
   ReportFramesOutsideImu(dataset, *source, request.config.estimator.model.max_imu_gap_s, &result);
   result.processing_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   FinishStatus(estimator, &result);

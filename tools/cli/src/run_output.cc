@@ -28,6 +28,14 @@ double MeanMs(const std::vector<FrameEstimate>& frames, Get get) {
   return sum / static_cast<double>(frames.size());
 }
 
+// `temp` (written in full) becomes `path`: a reader, or a run killed while
+// writing, sees the old file or the new one, never a part.
+void RenameOver(const std::string& temp, const std::string& path) {
+  std::error_code ec;
+  std::filesystem::rename(temp, path, ec);
+  if (ec) throw std::runtime_error(path + ": cannot replace: " + ec.message());
+}
+
 std::string StageTimesJson(const std::vector<FrameEstimate>& f) {
   std::ostringstream os;
   os << "{\"propagate\": " << JsonNumber(MeanMs(f, [](auto& e) { return e.timing.propagate_ms; }))
@@ -73,6 +81,13 @@ void RunOutput::AddFrame(const FrameEstimate& estimate) {
   pose.accel_bias = estimate.accel_bias;
   trajectory_.push_back(pose);
   frames_.push_back(estimate);
+  const std::string path = dir_ + "/trajectory.txt";
+  if (!streamed_.is_open()) {
+    streamed_.open(path, std::ios::binary | std::ios::trunc);
+    streamed_ << kTumTrajectoryHeader;
+  }
+  streamed_ << TumTrajectoryLine(pose, path) << std::flush;
+  if (!streamed_) throw std::runtime_error(path + ": cannot write");
 }
 
 void RunOutput::ReplaceEstimates(const std::vector<FrameEstimate>& estimates) {
@@ -89,7 +104,12 @@ void RunOutput::ReplaceEstimates(const std::vector<FrameEstimate>& estimates) {
   }
 }
 
-void RunOutput::WriteTrajectory() const { WriteTumTrajectory(trajectory_, dir_ + "/trajectory.txt"); }
+void RunOutput::WriteTrajectory() {
+  if (streamed_.is_open()) streamed_.close();
+  const std::string path = dir_ + "/trajectory.txt";
+  WriteTumTrajectory(trajectory_, path + ".tmp");
+  RenameOver(path + ".tmp", path);
+}
 
 void RunOutput::WriteTiming() const {
   std::ofstream out = OpenForWriting(dir_ + "/timing.csv");
@@ -106,11 +126,11 @@ void RunOutput::WriteTiming() const {
 
 void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_json, const RunRequest& request,
                              double peak_memory_mb, const std::string& waiting_reason) const {
-  std::ofstream out = OpenForWriting(dir_ + "/summary.json");
+  std::ofstream out = OpenForWriting(dir_ + "/summary.json.tmp");
   const PolicyOptions& policy = request.config.estimator.policy;
   out << "{\n  \"dataset\": " << JsonString(request.dataset_dir) << ",\n  \"policy\": " << JsonString(policy.policy)
       << ",\n  \"window_size\": " << policy.window_size
-      << ",\n  \"trajectory\": " << JsonString(policy.policy == "batch" ? "final" : request.trajectory)
+      << ",\n  \"trajectory\": " << JsonString(r.trajectory)
       << ",\n  \"status\": " << JsonString(r.status)
       << ",\n  \"problems\": " << ProblemsJson(r.problems) << ",\n  \"health\": " << HealthJson(r.health)
       << ",\n  \"frames\": " << r.frames << ",\n  \"frames_estimated\": " << r.frames_estimated
@@ -136,6 +156,9 @@ void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_jso
   }
   if (r.nees) out << ",\n  \"nees\": " << NeesJson(*r.nees);
   out << "\n}\n";
+  out.close();
+  if (!out) throw std::runtime_error(dir_ + "/summary.json.tmp: cannot write");
+  RenameOver(dir_ + "/summary.json.tmp", dir_ + "/summary.json");
 }
 
 void RunOutput::AddCovariance(const StateCovariance& covariance) { covariances_.push_back(covariance); }

@@ -1,5 +1,9 @@
 #pragma once
 // The files of one run's output folder (see run.h). Private to tools.
+// trajectory.txt grows a line (flushed) per AddFrame, so that a run stopped
+// at any point leaves the frames estimated so far; WriteTrajectory then
+// replaces it whole (temporary file + rename) with the run's final poses.
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -14,6 +18,7 @@ class RunOutput {
   /// Creates `dir`; throws std::runtime_error when it cannot.
   explicit RunOutput(std::string dir);
 
+  /// Appends the frame's pose to trajectory.txt at once (flushed).
   void AddFrame(const FrameEstimate& estimate);
   /// Overwrites the poses of the frames with these stamps (an offline
   /// policy's final estimates); timing rows stay.
@@ -21,7 +26,8 @@ class RunOutput {
   /// The estimated poses so far (t, p_w_b, q_w_b).
   const std::vector<GroundTruthState>& trajectory() const { return trajectory_; }
 
-  void WriteTrajectory() const;
+  /// Replaces trajectory.txt by every frame's pose as it is now (atomically).
+  void WriteTrajectory();
   void WriteTiming() const;
   void WriteSummary(const RunResult& result, const std::string& frontend_json, const RunRequest& request,
                     double peak_memory_mb, const std::string& waiting_reason) const;
@@ -39,6 +45,7 @@ class RunOutput {
 
  private:
   std::string dir_;
+  std::ofstream streamed_;  ///< trajectory.txt while the frames are estimated
   std::vector<GroundTruthState> trajectory_;
   std::vector<FrameEstimate> frames_;
   std::vector<StateCovariance> covariances_;

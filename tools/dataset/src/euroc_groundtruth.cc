@@ -118,15 +118,19 @@ void WriteGroundTruthCsv(const std::vector<GroundTruthState>& gt, const std::str
   out.Save();
 }
 
+std::string TumTrajectoryLine(const GroundTruthState& pose, const std::string& path) {
+  TextWriter out(path);
+  out.DecimalSeconds(pose.t_ns);
+  AppendVector3(out, pose.p_w_b, " ");
+  AppendVector3(out, pose.q_w_b.vec(), " ");
+  out.Text(" ").Double(pose.q_w_b.w()).Text("\n");
+  return out.text();
+}
+
 void WriteTumTrajectory(const std::vector<GroundTruthState>& poses, const std::string& path) {
   TextWriter out(path);
-  out.Text("# timestamp[s] tx ty tz qx qy qz qw\n");
-  for (const GroundTruthState& state : poses) {
-    out.DecimalSeconds(state.t_ns);
-    AppendVector3(out, state.p_w_b, " ");
-    AppendVector3(out, state.q_w_b.vec(), " ");
-    out.Text(" ").Double(state.q_w_b.w()).Text("\n");
-  }
+  out.Text(kTumTrajectoryHeader);
+  for (const GroundTruthState& state : poses) out.Text(TumTrajectoryLine(state, path));
   out.Save();
 }
 

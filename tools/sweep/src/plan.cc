@@ -177,7 +177,7 @@ std::string JobCommand(const SweepRequest& request, const SweepRun& run) {
   std::string command;
   for (const std::string& arg : RunArguments(request, run)) command += (command.empty() ? "" : " ") + ShellQuote(arg);
   return "d=" + ShellQuote(run.run_dir) + "; [ -f \"$d/done\" ] || { rm -rf \"$d\" && mkdir -p \"$d\" && " +
-         command + " >\"$d/run.log\" 2>&1; rc=$?; if [ -f \"$d/summary.json\" ]; then echo \"exit_code=$rc\" " +
+         command + " >\"$d/run.log\" 2>&1; rc=$?; if [ -f \"$d/summary.json\" ] && [ $rc -ne 130 ] && [ $rc -ne 143 ]; then echo \"exit_code=$rc\" " +
          ">\"$d/done.tmp\" && mv \"$d/done.tmp\" \"$d/done\"; fi; exit $rc; }";
 }
 

@@ -42,8 +42,17 @@ pid_t StartRun(const SweepRequest& request, const SweepRun& run) {
   return SpawnProcess(argv, run.run_dir + "/run.log");
 }
 
-// After the process ended: the marker when it left a summary, then the result.
+// After the process ended: the marker when it left a summary and was not
+// stopped by a signal, then the result.
 SweepResult FinishRun(const SweepRun& run, int exit_code) {
+  if (IsInterruptedExitCode(exit_code)) {
+    SweepResult result;
+    result.run = run;
+    result.status = "interrupted";
+    result.exit_code = exit_code;
+    result.message = "stopped by a signal; the next sweep redoes it";
+    return result;
+  }
   if (fs::exists(run.run_dir + "/summary.json")) WriteDoneMarker(run.run_dir, exit_code);
   SweepResult result = ReadRunResult(run);
   if (result.status == "missing") {
@@ -143,7 +152,16 @@ std::vector<SweepResult> RunSweep(const SweepRequest& request, std::ostream& pro
   }
   std::vector<std::pair<size_t, pid_t>> running;  // (plan index, process)
   size_t next = 0;
+  int forwarded = 0;  // the stop signal, once passed on to the running runs
   while (next < pending.size() || !running.empty()) {
+    if (const int signal = request.stop_signal ? request.stop_signal() : 0; signal != 0 && forwarded == 0) {
+      for (const auto& [index, pid] : running) kill(pid, signal);
+      forwarded = signal;
+      for (; next < pending.size(); ++next) {  // nothing more starts
+        results[pending[next]].run = plan[pending[next]];
+        results[pending[next]].message = "not started: the sweep was stopped";
+      }
+    }
     while (static_cast<int>(running.size()) < std::max(1, request.jobs) && next < pending.size()) {
       running.emplace_back(pending[next], StartRun(request, plan[pending[next]]));
       ++next;

@@ -70,6 +70,9 @@ class Estimator {
   std::optional<Eigen::Isometry3d> PredictBodyPose(Timestamp t_ns) const;
 
   const Window& window() const { return window_; }
+  /// The caller's stop request and progress hook for every solve from now on (solve_control.h):
+  /// a stopped solve keeps its iterate and counts in window().health().stopped_solves.
+  void SetSolveControl(SolveControl control) { window_.SetSolveControl(std::move(control)); }
   /// The newest state's marginal covariance from the window's information
   /// at the current estimate (window_covariance.h); nothing before
   /// initialization or when the information is singular.

@@ -21,6 +21,7 @@
 #include "vio/estimator/first_estimates.h"
 #include "vio/estimator/gauss_newton.h"
 #include "vio/estimator/imu_preintegration.h"
+#include "vio/estimator/solve_control.h"
 #include "vio/estimator/types.h"
 
 namespace vio {
@@ -64,6 +65,7 @@ struct SolveReport {
   double final_cost = 0;
   bool usable = true;
   bool converged = false;  ///< gn, Solve: stopped by the convergence criterion, not the cap
+  bool stopped = false;    ///< ended early by SolveControl::stop (the iterate reached is kept)
 };
 
 /// What Marginalize and the Drop* calls removed, in call order.
@@ -81,6 +83,7 @@ struct WindowHealth {
   int failed_solves = 0;      ///< solves whose result Ceres reported unusable
   int rejected_steps = 0;     ///< Gauss-Newton steps undone: their end point did not evaluate
   int dropped_observations = 0;  ///< observations that did not evaluate at a rejected step's end point: dropped
+  int stopped_solves = 0;     ///< solves ended early by SolveControl::stop (their iterate is not converged)
 };
 
 class Window {
@@ -122,6 +125,9 @@ class Window {
   /// Exactly `steps` steps (a filter's update: one Gauss-Newton step); with
   /// step=lm, `steps` Levenberg-Marquardt iterations (rejected ones count).
   SolveReport TakeSteps(int steps, const SolverOptions& options);
+  /// The caller's stop request and progress hook, used by every Solve and TakeSteps from now on.
+  void SetSolveControl(SolveControl control) { solve_control_ = std::move(control); }
+  const SolveControl& solve_control() const { return solve_control_; }
   /// Re-preintegrates IMU factors whose gyro-bias linearization moved too far.
   int RefreshImuFactors(double gyro_bias_threshold);
   /// J^T J of the whole cost at the current values over the tangent spaces of the states'
@@ -273,6 +279,7 @@ class Window {
   Removals removals_;
   WindowHealth health_;
   FactorWrapper wrapper_;
+  SolveControl solve_control_;
   /// The exact Gauss-Newton path's solver, re-laid out for every solve: its
   /// buffers (a window's normal equations, a few MB) are reused frame after frame.
   std::unique_ptr<GaussNewtonSolver> gauss_newton_;

@@ -20,6 +20,10 @@ class ProgressBar {
   void Update(std::int64_t done);
   /// Draws 100 % and ends the line.
   void Finish();
+  /// Ends the line where the bar is (a run stopped before the end).
+  void Stop();
+  /// Text after the count (a long solve's iteration and cost), drawn now; empty removes it.
+  void SetNote(std::string note);
 
  private:
   void Draw();
@@ -27,6 +31,8 @@ class ProgressBar {
   std::int64_t total_;
   std::int64_t done_ = 0;
   std::string unit_;
+  std::string note_;
+  size_t drawn_length_ = 0;  ///< of the last line drawn (a shorter one is padded over it)
   std::ostream* out_;
   bool enabled_;
   bool finished_ = false;

@@ -3,7 +3,9 @@
 // by frame, write the results, evaluate against ground truth when it exists.
 //
 // Output folder:
-//   trajectory.txt  TUM text, body in world: t[s] x y z qx qy qz qw, one row per estimated frame
+//   trajectory.txt  TUM text, body in world: t[s] x y z qx qy qz qw, one row per estimated frame; while
+//                   the run goes, each frame's online estimate is appended (flushed) as it is made, and at
+//                   the end the file is replaced whole (temporary file + rename) by the trajectory asked for
 //   timing.csv      per frame: stage times [ms], solver iterations, window size
 //   summary.json    counts (frame gaps, tracking loss), time per stage, real-time factor, peak memory,
 //                   ATE/RPE (when ground truth exists)
@@ -12,6 +14,7 @@
 //   nees.csv        with output_covariance and ground truth: per-frame NEES (nees.h), means in summary.json
 //   observations.csv  with output_observations: the stereo observations given to the estimator
 //                   (observations_csv.h; `vio matchcheck` checks them against a rendered dataset's scene)
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,6 +37,11 @@ struct RunRequest {
   /// "smoothed" (as last estimated: when its state left the window, or at the end; Estimator::LastEstimates).
   /// batch writes its final solve either way.
   std::string trajectory = "online";
+  /// Asked between frames and between solver iterations: a signal number (SIGINT, SIGTERM) ends
+  /// the run there with status interrupted, writing what was estimated. Empty: never.
+  std::function<int()> stop_signal;
+  /// Progress of long solves (iterations, cost) in the log, and with show_progress on a terminal.
+  bool show_solve_progress = true;
 };
 
 /// What a run could not do or had to reject (summary.json "health").
@@ -72,7 +80,13 @@ struct RunResult {
   /// kMaxInitWaitFraction of the frames waited for initialization),
   /// solver_failure, drifted (ATE RMSE > 0.5 m + 5% of the path). Not ok =
   /// exit code 1 of `vio run`; what was estimated is written either way.
+  /// interrupted: RunRequest::stop_signal ended the run (exit code 128 +
+  /// signal); the frames estimated until then are written.
   std::string status = "ok";
+  int stop_signal = 0;           ///< the signal that interrupted the run; 0 when none did
+  /// What trajectory.txt holds: online, smoothed or final (an offline policy's final solve; when
+  /// that solve was interrupted, the iterate it had reached).
+  std::string trajectory = "online";
   std::vector<std::string> problems;  ///< one message per problem (file and line where there is one)
   int frames = 0;                ///< frames in the dataset
   int frames_estimated = 0;      ///< frames with a pose in trajectory.txt

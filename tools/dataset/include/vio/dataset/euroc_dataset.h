@@ -124,6 +124,10 @@ std::vector<GroundTruthState> ReadGroundTruthCsv(const std::string& path);  ///<
 std::vector<GroundTruthState> ReadTumTrajectory(const std::string& path);   ///< t x y z qx qy qz qw
 void WriteGroundTruthCsv(const std::vector<GroundTruthState>& gt, const std::string& path);
 void WriteTumTrajectory(const std::vector<GroundTruthState>& poses, const std::string& path);
+/// WriteTumTrajectory's first line, and its line of one pose ("t x y z qx qy qz qw\n"; throws
+/// DatasetError naming `path` for a non-finite value): a file can be written a pose at a time.
+inline constexpr char kTumTrajectoryHeader[] = "# timestamp[s] tx ty tz qx qy qz qw\n";
+std::string TumTrajectoryLine(const GroundTruthState& pose, const std::string& path);
 std::vector<CameraFrame> ReadCameraCsv(const std::string& path);
 void WriteCameraCsv(const std::vector<CameraFrame>& frames, const std::string& path);
 /// Rows sorted by (t, camera, feature_id); an empty table (header only) is allowed.

@@ -23,6 +23,7 @@
 // A run that exits without a summary.json (unknown policy, bad flag, crash,
 // kill) is "failed" and is retried by the next sweep; a run that wrote its
 // summary (status ok, diverged or not_initialized) is finished and kept.
+#include <functional>
 #include <iosfwd>
 #include <limits>
 #include <string>
@@ -51,7 +52,15 @@ struct SweepRequest {
   int jobs = 1;                       ///< runs at a time
   int seeds = 0;                      ///< Monte Carlo realizations (noise seeds); 0 = the datasets as given
   std::vector<std::string> simulate_flags;  ///< `vio simulate` flags of the Monte Carlo datasets
+  /// Asked while runs go: a signal number (SIGINT, SIGTERM) stops the sweep: no further run starts,
+  /// the running ones get the signal (they stop and write what they estimated) and are waited for.
+  /// Empty: never.
+  std::function<int()> stop_signal;
 };
+
+/// Exit codes of a run stopped by SIGINT or SIGTERM (128 + signal): it wrote its summary (status
+/// interrupted) but is not finished: no `done` marker, the next sweep redoes it.
+inline bool IsInterruptedExitCode(int exit_code) { return exit_code == 130 || exit_code == 143; }
 
 /// One combination of the sweep.
 struct SweepRun {
@@ -79,7 +88,8 @@ struct SweepResult {
   SweepRun run;
   /// ok | diverged | not_initialized (summary.json's status), failed (the
   /// process ended without a summary.json, or it is malformed), missing (not
-  /// run yet: no `done` marker).
+  /// run yet: no `done` marker), interrupted (stopped by a signal; redone by
+  /// the next sweep).
   std::string status = "missing";
   int exit_code = -1;              ///< of `vio run`; -1 when unknown
   std::string message;             ///< why it is not ok (e.g. the last line of run.log)
@@ -130,7 +140,8 @@ SweepResult ExecuteRun(const SweepRequest& request, const SweepRun& run);
 
 /// Runs every unfinished combination, request.jobs at a time, and reuses the
 /// finished ones. Writes one progress line per run to `progress`. Results in
-/// plan order.
+/// plan order. A stop request (request.stop_signal) ends it early: the runs
+/// not started are "missing", the stopped ones "interrupted".
 std::vector<SweepResult> RunSweep(const SweepRequest& request, std::ostream& progress);
 
 /// Reads every combination's folder (nothing is run).
