@@ -73,13 +73,15 @@ std::vector<std::string> RunArgs(const std::string& output_dir, const std::strin
   return {VIO_BINARY, "run", "--dataset=" + LongDataset(), "--output_dir=" + output_dir, "--policy=" + policy};
 }
 
-// `vio run` as a child process (stdout and stderr to log).
-pid_t Start(const std::vector<std::string>& args, const std::string& log) {
+// `vio` as a child process (stdout and stderr to log); `own_group`: in a
+// process group of its own, as a shell's foreground job (its id is the pid).
+pid_t Start(const std::vector<std::string>& args, const std::string& log, bool own_group = false) {
   std::vector<char*> argv;
   for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
   argv.push_back(nullptr);
   const pid_t pid = fork();
   if (pid == 0) {
+    if (own_group) setpgid(0, 0);
     if (freopen(log.c_str(), "w", stdout) == nullptr || dup2(fileno(stdout), STDERR_FILENO) < 0) _exit(126);
     execv(argv[0], argv.data());
     _exit(127);
@@ -214,6 +216,43 @@ TEST(StoppedRun, BatchStoppedInItsFinalSolveWritesItsIterate) {
   ASSERT_EQ(written.size(), frames);
   EXPECT_NE(written, PoseLines(complete_dir + "/trajectory.txt")) << "one iteration is not the converged solve";
 }
+
+// `vio sweep` stopped while its first run goes: SIGTERM to the sweep alone
+// (it passes it on), or SIGINT to its whole process group (Ctrl-C: every run
+// gets it directly too, and the copy the sweep forwards is not a second
+// signal). The run writes its summary (interrupted) but no `done` marker, the
+// run not started has none either, and the same command then finishes both
+// (checked once).
+class StoppedSweep : public ::testing::TestWithParam<bool> {};
+
+TEST_P(StoppedSweep, LeavesItsRunsUnfinishedAndResumes) {
+  const bool whole_group = GetParam();
+  const std::string out = test::MakeTempDir("sweep_stopped");
+  const std::vector<std::string> args = {VIO_BINARY, "sweep", "--datasets=" + LongDataset(), "--runs=swf:10,msckf:10",
+                                         "--output_dir=" + out, "--plots=false", "--jobs=1"};
+  const std::string swf = out + "/runs/dataset/swf_10", msckf = out + "/runs/dataset/msckf_10";
+  const pid_t sweep = Start(args, out + "/sweep1.log", /*own_group=*/true);
+  ASSERT_TRUE(WaitForPoses(sweep, swf + "/trajectory.txt", 100)) << ReadFile(out + "/sweep1.log");
+  const int signal = whole_group ? SIGINT : SIGTERM;
+  kill(whole_group ? -sweep : sweep, signal);
+  EXPECT_EQ(Wait(sweep), 128 + signal) << ReadFile(out + "/sweep1.log");
+  EXPECT_EQ(SummaryString(swf, "status"), "\"interrupted\"") << ReadFile(swf + "/run.log");
+  EXPECT_GE(PoseLines(swf + "/trajectory.txt").size(), 100u);
+  EXPECT_FALSE(test::PathExists(swf + "/done"));
+  EXPECT_FALSE(test::PathExists(msckf + "/done"));
+  EXPECT_NE(ReadFile(out + "/sweep1.log").find("interrupted (exit " + std::to_string(128 + signal) + ")"),
+            std::string::npos)
+      << ReadFile(out + "/sweep1.log");
+  if (whole_group) return;  // resuming is the same either way
+
+  EXPECT_EQ(Wait(Start(args, out + "/sweep2.log")), 0) << ReadFile(out + "/sweep2.log");
+  EXPECT_EQ(SummaryString(swf, "status"), "\"ok\"");
+  EXPECT_TRUE(test::PathExists(swf + "/done"));
+  EXPECT_TRUE(test::PathExists(msckf + "/done"));
+  EXPECT_EQ(PoseLines(swf + "/trajectory.txt"), CompleteRun("swf"));
+}
+
+INSTANTIATE_TEST_SUITE_P(Signals, StoppedSweep, ::testing::Values(false, true));
 
 }  // namespace
 }  // namespace vio::tools
