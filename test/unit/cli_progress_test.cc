@@ -44,5 +44,15 @@ TEST(ProgressBar, DrawsANoteAndClearsIt) {
   }
 }
 
+// A log line goes where the bar was: the bar's line is blanked first.
+TEST(ProgressBar, ClearsItsLineForALogLine) {
+  std::ostringstream out;
+  ProgressBar bar(10, "frames", &out, /*enabled=*/true);
+  bar.SetNote("solve");
+  const size_t drawn = out.str().size() - 1;  // after its '\r'
+  bar.ClearLine();
+  EXPECT_EQ(out.str().substr(out.str().size() - drawn - 2), "\r" + std::string(drawn, ' ') + "\r");
+}
+
 }  // namespace
 }  // namespace vio::tools

@@ -48,6 +48,12 @@ void ProgressBar::Stop() {
   finished_ = true;
 }
 
+void ProgressBar::ClearLine() {
+  if (!enabled_ || finished_ || drawn_length_ == 0) return;
+  *out_ << "\r" << std::string(drawn_length_, ' ') << "\r" << std::flush;
+  drawn_length_ = 0;
+}
+
 void ProgressBar::SetNote(std::string note) {
   note_ = std::move(note);
   if (!enabled_ || finished_) return;
@@ -67,7 +73,7 @@ void ProgressBar::Draw() {
                 static_cast<long long>(done_), static_cast<long long>(total_), unit_.c_str(), elapsed_s);
   std::string text = line;
   if (!note_.empty()) text += "  " + note_;
-  const size_t length = text.size();
+  const size_t length = text.size() - 1;  // after the '\r'
   if (length < drawn_length_) text.append(drawn_length_ - length, ' ');
   drawn_length_ = length;
   *out_ << text << std::flush;

@@ -27,6 +27,7 @@ void SolveProgressLog::Hear(const SolveProgress& progress) {
   std::snprintf(text, sizeof(text), "%s: iteration %d/%d, cost %.6g (from %.6g), %.1f s", phase_.c_str(),
                 progress.iteration, progress.max_iterations, progress.cost, progress.initial_cost,
                 progress.elapsed_s);
+  if (bar_ != nullptr) bar_->ClearLine();
   LOG(INFO) << text;
   if (bar_ != nullptr) bar_->SetNote(text);
   noted_ = true;

@@ -24,6 +24,8 @@ class ProgressBar {
   void Stop();
   /// Text after the count (a long solve's iteration and cost), drawn now; empty removes it.
   void SetNote(std::string note);
+  /// Blanks the bar's line (a log line is then written in its place; the next draw is below it).
+  void ClearLine();
 
  private:
   void Draw();
