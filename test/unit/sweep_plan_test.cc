@@ -1,6 +1,10 @@
 // `vio sweep` planning: the combinations, their run folders, the `vio run`
 // command lines and the shell lines of jobs.txt.
+#include <sys/wait.h>
+
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -96,8 +100,30 @@ TEST(SweepPlan, JobLineSkipsFinishedRunsAndWritesTheMarkerOnlyWithASummary) {
   EXPECT_EQ(line.rfind("d=" + ShellQuote(run.run_dir) + "; [ -f \"$d/done\" ] || {", 0), 0u) << line;
   EXPECT_THAT(line, HasSubstr("rm -rf \"$d\" && mkdir -p \"$d\" && '/opt/vio/bin/vio' 'run' "));
   EXPECT_THAT(line, HasSubstr("'--policy=swf' '--window_size=5' >\"$d/run.log\" 2>&1; rc=$?;"));
-  EXPECT_THAT(line, HasSubstr("if [ -f \"$d/summary.json\" ]; then echo \"exit_code=$rc\" >\"$d/done.tmp\" && "
-                              "mv \"$d/done.tmp\" \"$d/done\"; fi; exit $rc; }"));
+  EXPECT_THAT(line, HasSubstr("if [ -f \"$d/summary.json\" ] && [ $rc -ne 130 ] && [ $rc -ne 143 ]; then echo "
+                              "\"exit_code=$rc\" >\"$d/done.tmp\" && mv \"$d/done.tmp\" \"$d/done\"; fi; exit $rc; }"));
+}
+
+// The job line run by a shell, with a stand-in `vio` that writes its summary and exits with
+// $FAKE_RC: `done` follows any exit code but a signal's (130, 143: the run was stopped, redo it).
+TEST(SweepPlan, JobLineLeavesARunStoppedByASignalUnfinished) {
+  SweepRequest request = TwoDatasetRequest();
+  request.vio_binary = std::filesystem::path(request.output_dir).parent_path().string() + "/fake_vio.sh";
+  {
+    std::ofstream script(request.vio_binary);
+    script << "#!/bin/sh\nfor a; do case \"$a\" in --output_dir=*) d=\"${a#--output_dir=}\";; esac; done\n"
+              "echo '{\"status\": \"x\"}' > \"$d/summary.json\"; exit $FAKE_RC\n";
+  }
+  std::filesystem::permissions(request.vio_binary, std::filesystem::perms::owner_all);
+  const SweepRun run = PlanSweep(request)[0];
+  for (const int rc : {0, 1, 130, 143}) {
+    std::filesystem::remove_all(run.run_dir);
+    const std::string command = "FAKE_RC=" + std::to_string(rc) + " sh -c " + ShellQuote(JobCommand(request, run));
+    const int status = std::system(command.c_str());
+    EXPECT_EQ(WEXITSTATUS(status), rc);
+    EXPECT_TRUE(std::filesystem::exists(run.run_dir + "/summary.json")) << rc;
+    EXPECT_EQ(std::filesystem::exists(run.run_dir + "/done"), !IsInterruptedExitCode(rc)) << rc;
+  }
 }
 
 TEST(SweepPlan, ShellQuotingAndFlagSplitting) {

@@ -401,7 +401,7 @@ RunResult RunDataset(const RunRequest& requested) {
   const auto num_frames = static_cast<std::int64_t>(source->size());
   ProgressBar progress = request.show_progress ? ProgressBar(num_frames, "frames")
                                                : ProgressBar(num_frames, "frames", nullptr, false);
-  SolveProgressLog solve_log(&progress, request.show_solve_progress);
+  SolveProgressLog solve_log(&progress);
   estimator.SetSolveControl(MakeSolveControl(request, &solve_log));
   result.frames = static_cast<int>(source->size());
   if (source->size() > 0) {

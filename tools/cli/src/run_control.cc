@@ -17,7 +17,6 @@ void SolveProgressLog::SetPhase(std::string phase) { phase_ = std::move(phase); 
 
 void SolveProgressLog::Hear(const SolveProgress& progress) {
   last_ = progress;
-  if (!enabled_) return;
   if (progress.elapsed_s < kLongSolveS) {
     if (noted_ && bar_ != nullptr) bar_->SetNote("");
     noted_ = false;

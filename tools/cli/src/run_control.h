@@ -24,8 +24,8 @@ class SolveProgressLog {
  public:
   static constexpr double kLongSolveS = 1.0;
 
-  /// `bar` may be null (nothing drawn); `enabled` false: silent.
-  SolveProgressLog(ProgressBar* bar, bool enabled) : bar_(bar), enabled_(enabled) {}
+  /// `bar` may be null (nothing drawn).
+  explicit SolveProgressLog(ProgressBar* bar) : bar_(bar) {}
   /// Names the solves from now on in the log ("solve", "final solve").
   void SetPhase(std::string phase);
   void Hear(const SolveProgress& progress);
@@ -34,7 +34,6 @@ class SolveProgressLog {
 
  private:
   ProgressBar* bar_;
-  bool enabled_;
   std::string phase_ = "solve";
   bool noted_ = false;  ///< the bar shows a note
   std::optional<SolveProgress> last_;

@@ -40,8 +40,6 @@ struct RunRequest {
   /// Asked between frames and between solver iterations: a signal number (SIGINT, SIGTERM) ends
   /// the run there with status interrupted, writing what was estimated. Empty: never.
   std::function<int()> stop_signal;
-  /// Progress of long solves (iterations, cost) in the log, and with show_progress on a terminal.
-  bool show_solve_progress = true;
 };
 
 /// What a run could not do or had to reject (summary.json "health").
