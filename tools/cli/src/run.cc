@@ -133,6 +133,13 @@ void StopAt(size_t k, size_t num_frames, const std::string& status, const std::s
   result->health.frames_after_stop = static_cast<int>(num_frames - k);
 }
 
+// What the data shows cannot be right (rig_checks.h, swapped cameras): the run stops with it.
+std::string InputProblem(const FrameSource& source, const Estimator& estimator) {
+  const std::string from_frames = source.InputProblem();
+  if (!from_frames.empty()) return "bad input: " + from_frames;
+  return estimator.input_problem().empty() ? "" : "bad input: " + estimator.input_problem();
+}
+
 // Frame intervals longer than 1.5 median intervals: missing frames.
 void CountFrameGaps(const FrameSource& source, RunResult* result) {
   std::vector<Timestamp> intervals;
@@ -202,6 +209,10 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
       if (observations != nullptr) observations->Add(frame);
       const FrameEstimate estimate = estimator.ProcessFrame(frame);
       progress.Update(static_cast<std::int64_t>(k + 1));
+      if (const std::string problem = InputProblem(source, estimator); !problem.empty()) {
+        StopAt(k, source.size(), "bad_input", problem, result);
+        break;
+      }
       if (!estimate.initialized) {
         ++result->health.frames_waiting_init;
         result->init.last_reason = estimator.waiting_reason();

@@ -28,7 +28,8 @@ std::string FeaturesReportJson(const StereoFramesReport& r) {
      << r.stereo_observations << ", \"left_only\": " << r.left_only << ", \"right_only\": " << r.right_only
      << ", \"rejected_epipolar\": " << r.rejected_epipolar << ", \"rejected_disparity\": " << r.rejected_disparity
      << ", \"rejected_outside_image\": " << r.rejected_outside_image << ", \"unrectifiable\": " << r.unrectifiable
-     << ", \"observations_off_frames\": " << r.observations_off_frames << "}";
+     << ", \"observations_off_frames\": " << r.observations_off_frames
+     << ", \"consistent_if_swapped\": " << r.consistent_if_swapped << "}";
   return os.str();
 }
 
@@ -43,6 +44,7 @@ class FeaturesSource final : public FrameSource {
   Timestamp time(size_t k) const override { return frames_[k].t_ns; }
   StereoFrame Frame(size_t k, const Estimator&) override { return frames_[k]; }
   std::string ReportJson() const override { return FeaturesReportJson(report_); }
+  std::string InputProblem() const override { return SwappedCamerasProblem(report_); }
 
  private:
   StereoFramesReport report_;
@@ -82,6 +84,7 @@ class FeatureStreamSource final : public FrameSource {
   }
 
   std::string ReportJson() const override { return FeaturesReportJson(report_); }
+  std::string InputProblem() const override { return SwappedCamerasProblem(report_); }
 
  private:
   FeatureCsvStream stream_;

@@ -25,6 +25,9 @@ class FrameSource {
   virtual StereoFrame Frame(size_t k, const Estimator& estimator) = 0;
   /// Counts for summary.json's "frontend" object (a JSON object).
   virtual std::string ReportJson() const = 0;
+  /// Set when the frames show the input cannot be right (swapped cameras): what is wrong and how to
+  /// fix it. The run stops there.
+  virtual std::string InputProblem() const { return ""; }
 };
 
 /// The front end `frontend` (a FrontendOptions::frontend value) stands for on
