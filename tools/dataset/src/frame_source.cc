@@ -96,6 +96,27 @@ class FeatureStreamSource final : public FrameSource {
   StereoFramesReport report_;
 };
 
+// Another source's frames with their stamps moved onto the IMU's clock.
+class ShiftedSource final : public FrameSource {
+ public:
+  ShiftedSource(std::unique_ptr<FrameSource> source, Timestamp shift_ns)
+      : source_(std::move(source)), shift_ns_(shift_ns) {}
+
+  size_t size() const override { return source_->size(); }
+  Timestamp time(size_t k) const override { return source_->time(k) + shift_ns_; }
+  StereoFrame Frame(size_t k, const Estimator& estimator) override {
+    StereoFrame frame = source_->Frame(k, estimator);
+    frame.t_ns += shift_ns_;
+    return frame;
+  }
+  std::string ReportJson() const override { return source_->ReportJson(); }
+  std::string InputProblem() const override { return source_->InputProblem(); }
+
+ private:
+  std::unique_ptr<FrameSource> source_;
+  Timestamp shift_ns_;
+};
+
 }  // namespace
 
 std::string ResolveFrontend(const std::string& frontend, const EurocDataset& dataset) {
@@ -123,6 +144,11 @@ std::unique_ptr<FrameSource> MakeFrameSource(const FrontendOptions& options, con
                              "(generate one with `vio simulate --from=" + dataset.root + "`)" + images_hint);
   }
   return std::make_unique<FeaturesSource>(dataset, rectifier, options.max_epipolar_px);
+}
+
+std::unique_ptr<FrameSource> ShiftFrameTimes(std::unique_ptr<FrameSource> source, Timestamp shift_ns) {
+  if (shift_ns == 0) return source;
+  return std::make_unique<ShiftedSource>(std::move(source), shift_ns);
 }
 
 }  // namespace vio::tools

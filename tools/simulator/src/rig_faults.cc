@@ -1,6 +1,8 @@
 #include "vio/simulator/rig_faults.h"
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <stdexcept>
 
 namespace vio::tools {
@@ -30,6 +32,9 @@ void ApplyRigFaults(const RigFaults& faults, EurocDataset* dataset) {
   }
   if (!faults.swap_cameras) return;
   for (FeatureObservation& obs : dataset->features) obs.camera = 1 - obs.camera;
+  std::sort(dataset->features.begin(), dataset->features.end(), [](const auto& a, const auto& b) {
+    return std::tie(a.t_ns, a.camera, a.feature_id) < std::tie(b.t_ns, b.camera, b.feature_id);
+  });
 }
 
 }  // namespace vio::tools

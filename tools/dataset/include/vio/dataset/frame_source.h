@@ -41,4 +41,8 @@ std::string ResolveFrontend(const std::string& frontend, const EurocDataset& dat
 std::unique_ptr<FrameSource> MakeFrameSource(const FrontendOptions& options, const EurocDataset& dataset,
                                              const frontend::StereoRectifier& rectifier);
 
+/// `source` with every frame stamp moved by `shift_ns` onto the IMU's clock (a camera-IMU time
+/// offset: EurocDataset::camera_time_offset_ns, shift = -camera_time_offset_ns); `source` itself when 0.
+std::unique_ptr<FrameSource> ShiftFrameTimes(std::unique_ptr<FrameSource> source, Timestamp shift_ns);
+
 }  // namespace vio::tools
