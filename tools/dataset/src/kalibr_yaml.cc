@@ -11,7 +11,7 @@ namespace {
 namespace fs = std::filesystem;
 
 /// Largest |R^T R - I| entry accepted for a rotation.
-constexpr double kMaxRotationError = 1e-6;
+constexpr double kMaxKalibrRotationError = 1e-6;
 /// T_cn_cnm1 must agree with the two T_cam_imu to this (Kalibr writes both from one estimate).
 constexpr double kMaxChainTranslationError = 1e-3;  // [m]
 constexpr double kMaxChainRotationError = 1e-3;     // [rad]
@@ -33,7 +33,7 @@ Eigen::Isometry3d ReadRigid(const YamlFile& file, const YAML::Node& map, const s
   if (!T.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1), 1e-12)) file.Fail(node, "'" + key + "' last row must be [0, 0, 0, 1]");
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
   const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-  if (error > kMaxRotationError || R.determinant() < 0) {
+  if (error > kMaxKalibrRotationError || R.determinant() < 0) {
     file.Fail(node, "'" + key + "' rotation is not a rotation (|R^T R - I| = " + std::to_string(error) + ")");
   }
   T.row(3) << 0, 0, 0, 1;
