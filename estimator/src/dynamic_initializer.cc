@@ -180,6 +180,7 @@ DynamicInitResult InitializeDynamic(const std::vector<StereoFrame>& frames, cons
   }
   const VelocityGravity alignment = AlignVelocityGravity(motion.T_0_k, preintegrations, options.model.gravity,
                                                          options.init.prior_accel_bias_sigma, kStereoPositionSigma);
+  result.free_gravity_norm = alignment.free_gravity_norm;
   if (std::abs(alignment.free_gravity_norm - options.model.gravity) > kMaxGravityNormError * options.model.gravity) {
     std::ostringstream why;
     why << "stereo motion and IMU disagree: the alignment's gravity is " << alignment.free_gravity_norm
@@ -195,7 +196,9 @@ DynamicInitResult InitializeDynamic(const std::vector<StereoFrame>& frames, cons
     result.reason = "the refinement's bundle adjustment did not give a usable solution";
     return result;
   }
-  return FromRefinedWindow(window, options.init);
+  DynamicInitResult refined = FromRefinedWindow(window, options.init);
+  refined.free_gravity_norm = alignment.free_gravity_norm;
+  return refined;
 }
 
 std::optional<double> CameraPixelMotion(const std::vector<StereoFrame>& frames, int min_landmarks) {

@@ -8,14 +8,25 @@
 #include <glog/logging.h>
 
 #include "vio/estimator/dynamic_initializer.h"
+#include "vio/estimator/so3.h"
+#include "vio/estimator/stereo_motion.h"
 
 namespace vio {
+namespace {
+
+// Implausible dynamic initializations in a row that make an input problem (one alone can be a
+// window the motion does not determine).
+constexpr int kImplausibleInits = 3;
+
+}  // namespace
+
 Estimator::Estimator(const EstimatorOptions& options, const ImuCalibration& imu, const RectifiedStereo& stereo)
     : options_(options),
       imu_calibration_(imu),
       window_(options.model, stereo),
       policy_(MakePolicy(options)),
-      tracking_(options.policy.min_frame_features, options.policy.window_size) {
+      tracking_(options.policy.min_frame_features, options.policy.window_size),
+      rig_limits_(RigLimitsFor(imu, options.model.gravity)) {
   imu_calibration_.gyro_noise_density *= options.model.imu_noise_scale;
   imu_calibration_.accel_noise_density *= options.model.imu_noise_scale;
   imu_calibration_.gyro_random_walk *= options.model.imu_noise_scale;
@@ -32,6 +43,7 @@ void Estimator::SetInitialState(const InitialState& state) { given_initial_state
 FrameEstimate Estimator::ProcessFrame(const StereoFrame& frame) {
   const auto start = std::chrono::steady_clock::now();
   window_.ClearRemovals();
+  CheckRotation(frame);
   FrameTiming timing;
   if (!last_state_.valid()) {
     if (!Initialize(frame)) {
@@ -95,7 +107,7 @@ bool Estimator::Initialize(const StereoFrame& frame) {
   return false;
 }
 
-std::optional<InitialState> Estimator::TryStatic(const StereoFrame& frame, std::string* reason, bool* moving) const {
+std::optional<InitialState> Estimator::TryStatic(const StereoFrame& frame, std::string* reason, bool* moving) {
   const StaticInitResult result = InitializeStatic(imu_, frame.t_ns, options_.init);
   *moving = result.moving;
   *reason = result.reason;
@@ -111,6 +123,12 @@ std::optional<InitialState> Estimator::TryStatic(const StereoFrame& frame, std::
     *reason = why.str();
     *moving = true;
     LOG(INFO) << "no static initialization: " << *reason;
+    return std::nullopt;
+  }
+  if (const std::string problem = CheckAtRest(result.accel_mean, result.state->gyro_bias, rig_limits_);
+      !problem.empty()) {
+    *reason = problem;
+    input_problem_ = problem;
     return std::nullopt;
   }
   LOG(INFO) << "static initialization at t=" << std::fixed << std::setprecision(3) << NanosToSeconds(frame.t_ns)
@@ -129,6 +147,10 @@ bool Estimator::TryDynamic(std::string* reason) {
     return false;
   }
   const DynamicInitResult result = InitializeDynamic(frames, imu_, imu_calibration_, window_.stereo(), options_);
+  if (const std::string implausible = CheckDynamicResult(result); !implausible.empty()) {
+    *reason = implausible;
+    return false;
+  }
   if (!result.state) {
     *reason = result.reason;
     return false;
@@ -146,6 +168,46 @@ bool Estimator::TryDynamic(std::string* reason) {
   }
   init_frames_.clear();
   return true;
+}
+
+std::string Estimator::CheckDynamicResult(const DynamicInitResult& result) {
+  std::string implausible = CheckFreeGravity(result.free_gravity_norm, rig_limits_);
+  if (implausible.empty() && result.state) {
+    implausible = CheckBiases(result.state->gyro_bias, result.state->accel_bias, rig_limits_, "dynamic initialization");
+  }
+  implausible_inits_ = implausible.empty() ? 0 : implausible_inits_ + 1;
+  if (implausible_inits_ >= kImplausibleInits) input_problem_ = implausible;
+  return implausible;
+}
+
+// Each frame is paired with the oldest of the last RotationCheck::kPairSpanS (at least half of it
+// back); the gyro's rotation between them is its readings integrated as a vector (IntegratedGyro).
+void Estimator::CheckRotation(const StereoFrame& frame) {
+  if (rotation_check_.decided()) return;
+  Eigen::Vector3d gyro_sum = Eigen::Vector3d::Zero();
+  if (!rotation_frames_.empty()) {
+    const RotationCheckFrame& last = rotation_frames_.back();
+    const bool covered = !imu_.empty() && imu_.front().t_ns <= last.frame.t_ns && imu_.back().t_ns >= frame.t_ns;
+    if (covered && last.frame.t_ns < frame.t_ns) {
+      gyro_sum = last.gyro_sum + IntegratedGyro(imu_, last.frame.t_ns, frame.t_ns);
+    } else {
+      rotation_frames_.clear();
+    }
+  }
+  rotation_frames_.push_back({frame, gyro_sum});
+  const Timestamp span_ns = SecondsToNanos(RotationCheck::kPairSpanS);
+  while (rotation_frames_.front().frame.t_ns < frame.t_ns - span_ns) rotation_frames_.pop_front();
+  const RotationCheckFrame& first = rotation_frames_.front();
+  if (2 * (frame.t_ns - first.frame.t_ns) < span_ns) return;
+  const std::optional<StereoRelativePose> camera =
+      RelativeStereoPose(first.frame, frame, window_.stereo(), options_.model, options_.init.dynamic_min_landmarks);
+  if (!camera) return;
+  rotation_check_.Add(rotation_frames_.back().gyro_sum - first.gyro_sum,
+                      so3::Log(Eigen::Matrix3d(camera->T_a_b.linear())));
+  if (rotation_check_.decided()) {
+    rotation_frames_.clear();
+    if (!rotation_check_.problem().empty()) input_problem_ = rotation_check_.problem();
+  }
 }
 
 std::vector<StereoFrame> Estimator::InitFrames(Timestamp t_ns, double span_s) const {

@@ -71,7 +71,7 @@ StaticInitResult InitializeStatic(const std::vector<ImuSample>& imu, Timestamp t
   // At rest the accelerometer measures R_w_b^T (0, 0, g): rotate its mean onto +z.
   state.q_w_b = Eigen::Quaterniond::FromTwoVectors(s.accel_mean.normalized(), Eigen::Vector3d::UnitZ());
   state.gyro_bias = s.gyro_mean;
-  return {state, ""};
+  return {state, "", false, s.accel_mean};
 }
 
 }  // namespace vio

@@ -90,11 +90,16 @@ void MsckfPolicy::LeaveWindow(const std::vector<StateId>& leaving, const std::ve
     ForgetObservationsOf(local_map_.Slide(window));
     return;
   }
+  // The solve may have dropped some of them (Window::Solve drops the observations that fail at a
+  // rejected step's end point, and a landmark they leave unobserved): only those still there go.
+  persistent_.ForgetAbsent(window);
   std::vector<LandmarkId> marginalized;
   for (LandmarkId id : added) {
-    if (!persistent_.IsKept(id)) marginalized.push_back(id);
+    if (!persistent_.IsKept(id) && window.HasLandmark(id)) marginalized.push_back(id);
   }
-  marginalized.insert(marginalized.end(), retired.begin(), retired.end());
+  for (LandmarkId id : retired) {
+    if (window.HasLandmark(id)) marginalized.push_back(id);
+  }
   window.Marginalize(leaving, marginalized);
   ForgetObservationsOf(leaving);
 }
@@ -184,6 +189,7 @@ std::vector<MsckfPolicy::TrackUpdate> MsckfPolicy::PromoteTracks(const StereoFra
                                                                  std::vector<LandmarkId>& retired) {
   std::vector<TrackUpdate> updates;
   if (!persistent_.enabled()) return updates;
+  persistent_.ForgetAbsent(window);
   std::set<LandmarkId> seen_now;
   for (const StereoObservation& obs : frame.observations) seen_now.insert(obs.landmark);
   std::vector<PromotionCandidate> candidates;

@@ -69,6 +69,12 @@ PersistentDecision PersistentLandmarks::Decide(Timestamp now_ns, const std::vect
   return decision;
 }
 
+void PersistentLandmarks::ForgetAbsent(const Window& window) {
+  for (auto it = kept_.begin(); it != kept_.end();) {
+    it = window.HasLandmark(it->first) ? std::next(it) : kept_.erase(it);
+  }
+}
+
 void LogPersistentCounts(const PersistentLandmarks& persistent) {
   if (!persistent.enabled()) return;
   const PersistentCounts& c = persistent.counts();
@@ -80,6 +86,7 @@ void LogPersistentCounts(const PersistentLandmarks& persistent) {
 std::vector<LandmarkId> KeepLongLived(const std::vector<LandmarkId>& marginalizing, Timestamp now_ns,
                                       const Window& window, PersistentLandmarks& persistent) {
   if (!persistent.enabled()) return marginalizing;
+  persistent.ForgetAbsent(window);
   std::vector<PromotionCandidate> candidates;
   for (LandmarkId id : marginalizing) {
     const Landmark& landmark = window.landmark(id);

@@ -107,7 +107,11 @@ void StereoRectifier::ComputeRectification() {
   rectified_.baseline = -P_[1](0, 3) / P_[1](0, 0);
   rectified_.T_b_cl = cam0.T_b_c;
   rectified_.T_b_cl.linear() = cam0.T_b_c.rotation() * R_rect_cam_[0].transpose();
-  CHECK_GT(rectified_.baseline, 0.0);
+  if (!(rectified_.baseline > 0.0)) {
+    throw std::invalid_argument("the calibration puts cam1 left of cam0 (rectified baseline " +
+                                std::to_string(rectified_.baseline) + " m): cam0 must be the left camera; are cam0 "
+                                "and cam1 swapped in the calibration (T_BS of cam0/cam1 sensor.yaml)?");
+  }
   CHECK_NEAR(P_[0](1, 1), rectified_.f, 1e-9 * rectified_.f);
   CHECK_LT(std::abs(P_[1](0, 2) - rectified_.cx), 1e-9 * rectified_.f)
       << "expected CALIB_ZERO_DISPARITY";

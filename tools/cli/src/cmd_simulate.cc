@@ -73,6 +73,12 @@ DEFINE_string(drop_pattern, "even",
               "where dropped frames go: even (gaps of exactly --drop_gap_frames, evenly spread) or burst (bursts of "
               "1 to --drop_gap_frames frames, more where the camera rotates fast, as real recordings drop them; e.g. "
               "--drop_frames=0.2 --drop_gap_frames=3 --drop_pattern=burst) {even|burst}");
+DEFINE_string(imu_gyro_units, "rad_s", "imu0/data.csv's gyro written in these units, a user's mistake on purpose "
+              "(sensor.yaml stays right): rad_s (right) or deg_s {rad_s|deg_s}");
+DEFINE_string(imu_accel_units, "m_s2", "imu0/data.csv's accelerometer written in these units, a user's mistake on "
+              "purpose: m_s2 (right) or g {m_s2|g}");
+DEFINE_bool(swap_cameras, false, "write cam0's measurements (features' camera column, images) as cam1's and back, "
+            "the calibration unchanged: a user's mistake on purpose");
 DEFINE_string(blackouts, "", "spans with nothing to track, START:DURATION[,...] in s after the first frame: "
               "no features, black images");
 
@@ -153,6 +159,9 @@ SimulatorOptions OptionsFromFlags() {
   options.gaps.gap_frames = FLAGS_drop_gap_frames;
   options.gaps.pattern = ParseDropPattern("drop_pattern", FLAGS_drop_pattern);
   options.gaps.blackouts = ParseBlackouts("blackouts", FLAGS_blackouts);
+  options.faults.gyro_units = FLAGS_imu_gyro_units;
+  options.faults.accel_units = FLAGS_imu_accel_units;
+  options.faults.swap_cameras = FLAGS_swap_cameras;
   return options;
 }
 

@@ -20,11 +20,32 @@
 #include "vio/cli/progress.h"
 #include "vio/dataset/frame_source.h"
 #include "vio/dataset/groundtruth_init.h"
+#include "vio/dataset/kalibr_calibration.h"
 #include "vio/dataset/observations_csv.h"
 #include "vio/dataset/rosbag_dataset.h"
 
 namespace vio::tools {
 namespace {
+
+// --calibration: an ASL folder's sensor.yaml files or Kalibr's camchain (and imu.yaml).
+void ApplyCalibration(const CalibrationOptions& options, EurocDataset* dataset) {
+  if (!IsCalibrationFile(options.calibration)) {
+    if (!options.calibration_imu.empty()) {
+      throw ConfigError("--calibration_imu is for a Kalibr camchain given as --calibration (a file), not a folder");
+    }
+    ApplyCalibrationFrom(options.calibration, dataset);
+    return;
+  }
+  const std::string imu = options.calibration_imu.empty() ? KalibrImuFileBeside(options.calibration)
+                                                         : options.calibration_imu;
+  const KalibrCalibration kalibr = ReadKalibr(options.calibration, imu);
+  dataset->cameras[0] = kalibr.cameras[0];
+  dataset->cameras[1] = kalibr.cameras[1];
+  dataset->imu_calibration = kalibr.imu;
+  dataset->camera_time_offset_ns = kalibr.camera_time_offset_ns;
+  LOG(INFO) << "calibration from Kalibr's " << options.calibration << " and " << imu << " (camera time offset "
+            << 1e-6 * static_cast<double>(kalibr.camera_time_offset_ns) << " ms)";
+}
 
 EurocDataset ReadRunDataset(const RunRequest& request) {
   if (IsBagPath(request.dataset_dir)) {
@@ -33,16 +54,14 @@ EurocDataset ReadRunDataset(const RunRequest& request) {
                                "(a folder with mav0/{cam0,cam1,imu0}/sensor.yaml)");
     }
     EurocDataset dataset = ReadBag(request.dataset_dir, request.config.bag);
-    ApplyCalibrationFrom(request.config.calibration.calibration, &dataset);
+    ApplyCalibration(request.config.calibration, &dataset);
     return dataset;
   }
   EurocReadOptions read;
   read.check_images = request.config.frontend.frontend != "features";
   read.stream_features = true;  // read frame by frame in the run loop, never held whole
   EurocDataset dataset = ReadEuroc(request.dataset_dir, read);
-  if (!request.config.calibration.calibration.empty()) {
-    ApplyCalibrationFrom(request.config.calibration.calibration, &dataset);
-  }
+  if (!request.config.calibration.calibration.empty()) ApplyCalibration(request.config.calibration, &dataset);
   return dataset;
 }
 
@@ -146,6 +165,13 @@ void Interrupt(size_t k, size_t num_frames, int signal, RunResult* result) {
   result->problems.push_back(message);
 }
 
+// What the data shows cannot be right (rig_checks.h, swapped cameras): the run stops with it.
+std::string InputProblem(const FrameSource& source, const Estimator& estimator) {
+  const std::string from_frames = source.InputProblem();
+  if (!from_frames.empty()) return "bad input: " + from_frames;
+  return estimator.input_problem().empty() ? "" : "bad input: " + estimator.input_problem();
+}
+
 // Frame intervals longer than 1.5 median intervals: missing frames.
 void CountFrameGaps(const FrameSource& source, RunResult* result) {
   std::vector<Timestamp> intervals;
@@ -222,6 +248,10 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
         break;
       }
       progress.Update(static_cast<std::int64_t>(k + 1));
+      if (const std::string problem = InputProblem(source, estimator); !problem.empty()) {
+        StopAt(k, source.size(), "bad_input", problem, result);
+        break;
+      }
       if (!estimate.initialized) {
         ++result->health.frames_waiting_init;
         result->init.last_reason = estimator.waiting_reason();
@@ -390,7 +420,9 @@ RunResult RunDataset(const RunRequest& requested) {
   RunRequest request = requested;
   request.config.frontend.frontend = ResolveFrontend(requested.config.frontend.frontend, dataset);
   const frontend::StereoRectifier rectifier(dataset.cameras[0], dataset.cameras[1]);
-  const std::unique_ptr<FrameSource> source = MakeFrameSource(request.config.frontend, dataset, rectifier);
+  // An image stamped t was taken at IMU time t - camera_time_offset_ns: the frames move onto the IMU's clock.
+  const std::unique_ptr<FrameSource> source = ShiftFrameTimes(
+      MakeFrameSource(request.config.frontend, dataset, rectifier), -dataset.camera_time_offset_ns);
   if (request.config.estimator.init.init == "groundtruth" && dataset.groundtruth.empty()) {
     throw std::runtime_error(request.dataset_dir + ": --init=groundtruth but the dataset has no ground truth");
   }

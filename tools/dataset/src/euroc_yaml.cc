@@ -13,6 +13,7 @@
 #include "csv_reader.h"
 #include "euroc_internal.h"
 #include "text_writer.h"
+#include "yaml_file.h"
 #include "vio/dataset/euroc_dataset.h"
 
 namespace vio::tools {
@@ -25,103 +26,27 @@ bool IsKnownDistortionModel(const std::string& model) {
   return model == "radial-tangential" || model == "equidistant";
 }
 
-// Typed, checked access to the nodes of one YAML file; errors name the file
-// and the line of the node concerned.
-class YamlFile {
- public:
-  explicit YamlFile(std::string path) : path_(std::move(path)), root_(LoadSensorYaml(path_)) {
-    if (!root_.IsMap()) throw LineError(path_, 1, "expected a YAML map of keys");
-  }
-
-  const YAML::Node& root() const { return root_; }
-
-  [[noreturn]] void Fail(const YAML::Node& node, const std::string& what) const {
-    const int line = node.Mark().is_null() ? 1 : node.Mark().line + 1;
-    throw LineError(path_, line, what);
-  }
-
-  YAML::Node Require(const YAML::Node& map, const std::string& key) const {
-    YAML::Node value = map[key];
-    if (!value.IsDefined() || value.IsNull()) Fail(map, "missing key '" + key + "'");
-    return value;
-  }
-
-  std::string String(const YAML::Node& map, const std::string& key) const {
-    const YAML::Node node = Require(map, key);
-    if (!node.IsScalar()) Fail(node, "'" + key + "' must be a single value");
-    return node.Scalar();
-  }
-
-  double Number(const YAML::Node& node, const std::string& what) const {
-    double value = 0.0;
-    if (!node.IsScalar() || !ParseDouble(node.Scalar(), &value)) {
-      Fail(node, "'" + what + "' is not a number" + Quoted(node));
-    }
-    if (!std::isfinite(value)) Fail(node, "'" + what + "' is not finite" + Quoted(node));
-    return value;
-  }
-
-  double Positive(const YAML::Node& map, const std::string& key) const {
-    const YAML::Node node = Require(map, key);
-    const double value = Number(node, key);
-    if (!(value > 0.0)) Fail(node, "'" + key + "' must be positive" + Quoted(node));
-    return value;
-  }
-
-  std::int64_t Integer(const YAML::Node& node, const std::string& what) const {
-    std::int64_t value = 0;
-    if (!node.IsScalar() || !ParseInt64(node.Scalar(), &value)) {
-      Fail(node, "'" + what + "' is not an integer" + Quoted(node));
-    }
-    return value;
-  }
-
-  std::vector<double> Numbers(const YAML::Node& map, const std::string& key,
-                              std::size_t expected) const {
-    const YAML::Node node = Require(map, key);
-    if (!node.IsSequence() || node.size() != expected) {
-      Fail(node, "'" + key + "' must be a list of " + std::to_string(expected) + " numbers, got " +
-                     (node.IsSequence() ? std::to_string(node.size()) + " values" : "no list"));
-    }
-    std::vector<double> values;
-    for (std::size_t i = 0; i < expected; ++i) {
-      values.push_back(Number(node[i], key + "[" + std::to_string(i) + "]"));
-    }
-    return values;
-  }
-
-  Eigen::Isometry3d ReadTBS() const;
-
- private:
-  static std::string Quoted(const YAML::Node& node) {
-    return node.IsScalar() ? ": \"" + node.Scalar() + "\"" : "";
-  }
-
-  std::string path_;
-  YAML::Node root_;
-};
-
-Eigen::Isometry3d YamlFile::ReadTBS() const {
-  const YAML::Node node = Require(root_, "T_BS");
-  const std::int64_t rows = Integer(Require(node, "rows"), "T_BS.rows");
-  const std::int64_t cols = Integer(Require(node, "cols"), "T_BS.cols");
-  const YAML::Node data = Require(node, "data");
+Eigen::Isometry3d ReadTBS(const YamlFile& file) {
+  const YAML::Node node = file.Require(file.root(), "T_BS");
+  const std::int64_t rows = file.Integer(file.Require(node, "rows"), "T_BS.rows");
+  const std::int64_t cols = file.Integer(file.Require(node, "cols"), "T_BS.cols");
+  const YAML::Node data = file.Require(node, "data");
   const std::size_t size = data.IsSequence() ? data.size() : 0;
   if (rows != 4 || cols != 4 || size != 16) {
-    Fail(node, "T_BS must be 4x4 with 16 values, got rows " + std::to_string(rows) + ", cols " +
+    file.Fail(node, "T_BS must be 4x4 with 16 values, got rows " + std::to_string(rows) + ", cols " +
                    std::to_string(cols) + ", " + std::to_string(size) + " values");
   }
-  const std::vector<double> values = Numbers(node, "data", 16);
+  const std::vector<double> values = file.Numbers(node, "data", 16);
   Eigen::Matrix4d T_b_s =
       Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(values.data());
   if (!T_b_s.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1), 1e-12)) {
-    Fail(node, "T_BS last row must be [0, 0, 0, 1]");
+    file.Fail(node, "T_BS last row must be [0, 0, 0, 1]");
   }
   const Eigen::Matrix3d R_b_s = T_b_s.topLeftCorner<3, 3>();
   const double rotation_error =
       (R_b_s.transpose() * R_b_s - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (rotation_error > kMaxRotationError) {
-    Fail(node,
+    file.Fail(node,
          "T_BS rotation is not orthonormal (|R^T R - I| = " + std::to_string(rotation_error) + ")");
   }
   T_b_s.row(3) << 0, 0, 0, 1;
@@ -189,7 +114,7 @@ CameraCalibration ReadCameraYaml(const std::string& path) {
   const YAML::Node& root = file.root();
   CheckOptionalSensorType(file, "camera");
   CameraCalibration camera;
-  camera.T_b_c = file.ReadTBS();
+  camera.T_b_c = ReadTBS(file);
   camera.rate_hz = file.Positive(root, "rate_hz");
   ReadResolution(file, &camera);
   if (const std::string model = file.String(root, "camera_model"); model != "pinhole") {
@@ -235,7 +160,7 @@ ImuCalibration ReadImuYaml(const std::string& path) {
   const YAML::Node& root = file.root();
   CheckOptionalSensorType(file, "imu");
   ImuCalibration imu;
-  imu.T_b_i = file.ReadTBS();
+  imu.T_b_i = ReadTBS(file);
   imu.rate_hz = file.Positive(root, "rate_hz");
   imu.gyro_noise_density = file.Positive(root, "gyroscope_noise_density");
   imu.gyro_random_walk = file.Positive(root, "gyroscope_random_walk");

@@ -28,7 +28,8 @@ std::string FeaturesReportJson(const StereoFramesReport& r) {
      << r.stereo_observations << ", \"left_only\": " << r.left_only << ", \"right_only\": " << r.right_only
      << ", \"rejected_epipolar\": " << r.rejected_epipolar << ", \"rejected_disparity\": " << r.rejected_disparity
      << ", \"rejected_outside_image\": " << r.rejected_outside_image << ", \"unrectifiable\": " << r.unrectifiable
-     << ", \"observations_off_frames\": " << r.observations_off_frames << "}";
+     << ", \"observations_off_frames\": " << r.observations_off_frames
+     << ", \"consistent_if_swapped\": " << r.consistent_if_swapped << "}";
   return os.str();
 }
 
@@ -43,6 +44,7 @@ class FeaturesSource final : public FrameSource {
   Timestamp time(size_t k) const override { return frames_[k].t_ns; }
   StereoFrame Frame(size_t k, const Estimator&) override { return frames_[k]; }
   std::string ReportJson() const override { return FeaturesReportJson(report_); }
+  std::string InputProblem() const override { return SwappedCamerasProblem(report_); }
 
  private:
   StereoFramesReport report_;
@@ -82,6 +84,7 @@ class FeatureStreamSource final : public FrameSource {
   }
 
   std::string ReportJson() const override { return FeaturesReportJson(report_); }
+  std::string InputProblem() const override { return SwappedCamerasProblem(report_); }
 
  private:
   FeatureCsvStream stream_;
@@ -91,6 +94,27 @@ class FeatureStreamSource final : public FrameSource {
   std::vector<FeatureObservation> group_;
   bool pending_ = false;  ///< group_ read and not yet used
   StereoFramesReport report_;
+};
+
+// Another source's frames with their stamps moved onto the IMU's clock.
+class ShiftedSource final : public FrameSource {
+ public:
+  ShiftedSource(std::unique_ptr<FrameSource> source, Timestamp shift_ns)
+      : source_(std::move(source)), shift_ns_(shift_ns) {}
+
+  size_t size() const override { return source_->size(); }
+  Timestamp time(size_t k) const override { return source_->time(k) + shift_ns_; }
+  StereoFrame Frame(size_t k, const Estimator& estimator) override {
+    StereoFrame frame = source_->Frame(k, estimator);
+    frame.t_ns += shift_ns_;
+    return frame;
+  }
+  std::string ReportJson() const override { return source_->ReportJson(); }
+  std::string InputProblem() const override { return source_->InputProblem(); }
+
+ private:
+  std::unique_ptr<FrameSource> source_;
+  Timestamp shift_ns_;
 };
 
 }  // namespace
@@ -120,6 +144,11 @@ std::unique_ptr<FrameSource> MakeFrameSource(const FrontendOptions& options, con
                              "(generate one with `vio simulate --from=" + dataset.root + "`)" + images_hint);
   }
   return std::make_unique<FeaturesSource>(dataset, rectifier, options.max_epipolar_px);
+}
+
+std::unique_ptr<FrameSource> ShiftFrameTimes(std::unique_ptr<FrameSource> source, Timestamp shift_ns) {
+  if (shift_ns == 0) return source;
+  return std::make_unique<ShiftedSource>(std::move(source), shift_ns);
 }
 
 }  // namespace vio::tools

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <map>
+#include <sstream>
 
 namespace vio::tools {
 namespace {
@@ -9,6 +10,13 @@ namespace {
 struct PixelPair {
   std::optional<Eigen::Vector2d> uv[2];
 };
+
+// True when the pair passes the epipolar and disparity tests with the cameras exchanged.
+bool ConsistentIfSwapped(const PixelPair& pair, const frontend::StereoRectifier& rectifier, double max_epipolar_px) {
+  const std::optional<Eigen::Vector2d> left = rectifier.Rectify(0, *pair.uv[1]);
+  const std::optional<Eigen::Vector2d> right = rectifier.Rectify(1, *pair.uv[0]);
+  return left && right && std::abs(left->y() - right->y()) <= max_epipolar_px && left->x() - right->x() > 0;
+}
 
 // One frame's rows (feature id -> pixels in cam0 / cam1) to measurements.
 void AddStereoObservations(const std::map<std::int64_t, PixelPair>& rows,
@@ -24,8 +32,12 @@ void AddStereoObservations(const std::map<std::int64_t, PixelPair>& rows,
     const std::optional<Eigen::Vector2d> left = rectifier.Rectify(0, *pair.uv[0]);
     const std::optional<Eigen::Vector2d> right = rectifier.Rectify(1, *pair.uv[1]);
     if (!left || !right) { ++report->unrectifiable; continue; }
-    if (std::abs(left->y() - right->y()) > max_epipolar_px) { ++report->rejected_epipolar; continue; }
-    if (left->x() - right->x() <= 0) { ++report->rejected_disparity; continue; }
+    const bool epipolar = std::abs(left->y() - right->y()) <= max_epipolar_px;
+    if (!epipolar || left->x() - right->x() <= 0) {
+      ++(epipolar ? report->rejected_disparity : report->rejected_epipolar);
+      report->consistent_if_swapped += ConsistentIfSwapped(pair, rectifier, max_epipolar_px);
+      continue;
+    }
     StereoObservation obs;
     obs.landmark = LandmarkId(id);
     obs.z_px = Eigen::Vector3d(left->x(), right->x(), 0.5 * (left->y() + right->y()));
@@ -68,6 +80,17 @@ std::vector<StereoFrame> StereoFramesFromFeatures(const std::vector<FeatureObser
   }
   report->frames = static_cast<int>(frames.size());
   return frames;
+}
+
+std::string SwappedCamerasProblem(const StereoFramesReport& report) {
+  const int pairs = report.stereo_observations + report.rejected_epipolar + report.rejected_disparity;
+  if (pairs < kSwappedMinPairs || 2 * report.consistent_if_swapped < pairs) return "";
+  std::ostringstream why;
+  why << report.consistent_if_swapped << " of " << pairs << " stereo pairs so far fit the stereo geometry only "
+      << "with cam0 and cam1 exchanged (" << report.stereo_observations << " as given): are the cameras swapped? "
+      << "cam0 must be the left camera: check the camera column of features0/data.csv against T_BS in cam0/cam1 "
+      << "sensor.yaml";
+  return why.str();
 }
 
 }  // namespace vio::tools

@@ -49,6 +49,7 @@ void CheckOptions(const SimulatorOptions& options) {
   }
   CheckSensorOptions(options.sensor);
   CheckImageTextureOptions(options.textures);
+  CheckRigFaults(options.faults);
   if (options.png_compression < 0 || options.png_compression > 9) {
     throw std::invalid_argument("simulator: PNG compression must be in 0..9, got " +
                                 std::to_string(options.png_compression));
@@ -326,9 +327,17 @@ Simulation BuildSimulation(const SimulatorOptions& options) {
 void WriteSimulation(const Simulation& simulation, const SimulatorOptions& options,
                      const RenderProgress& progress) {
   if (options.output_dir.empty()) throw std::invalid_argument("simulator: an output folder is required");
-  WriteEuroc(simulation.dataset, options.output_dir);
   WriteSceneCsv({simulation.scene.room, simulation.scene.boxes}, options.output_dir + "/mav0/scene.csv");
-  if (options.camera_output == SimCameraOutput::kImages) WriteImages(simulation, options, progress);
+  if (!options.faults.any()) {
+    WriteEuroc(simulation.dataset, options.output_dir);
+    if (options.camera_output == SimCameraOutput::kImages) WriteImages(simulation, options, progress);
+    return;
+  }
+  Simulation faulty = simulation;  // the calibration stays right, the measurements go wrong
+  ApplyRigFaults(options.faults, &faulty.dataset);
+  WriteEuroc(faulty.dataset, options.output_dir);
+  if (options.faults.swap_cameras) std::swap(faulty.dataset.cameras[0], faulty.dataset.cameras[1]);
+  if (options.camera_output == SimCameraOutput::kImages) WriteImages(faulty, options, progress);
 }
 
 SimulationSummary Simulate(const SimulatorOptions& options, const RenderProgress& progress) {

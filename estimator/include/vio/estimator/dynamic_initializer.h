@@ -35,6 +35,8 @@ struct DynamicInitResult {
   /// [dp (world), dtheta (body), v, b_g, b_a] (window_covariance.h).
   Eigen::Matrix<double, 15, 15> covariance = Eigen::Matrix<double, 15, 15>::Zero();
   std::string reason;  ///< set when `state` is empty
+  /// |g| of the visual-inertial alignment with gravity free, once it ran [m/s^2] (0 before).
+  double free_gravity_norm = 0;
   /// The refinement's estimates of the window's earlier frames (time order).
   std::vector<InitialState> earlier;
 };

@@ -3,15 +3,18 @@
 // initializes, adds one state per frame (predicted by the IMU and linked by a
 // preintegrated IMU factor) and hands the frame to the policy, which works
 // on the window.
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "vio/estimator/dynamic_initializer.h"
 #include "vio/estimator/estimator_options.h"
 #include "vio/estimator/initializer.h"
 #include "vio/estimator/policy.h"
+#include "vio/estimator/rig_checks.h"
 #include "vio/estimator/tracking_monitor.h"
 #include "vio/estimator/window.h"
 #include "vio/estimator/window_covariance.h"
@@ -90,6 +93,10 @@ class Estimator {
   const std::string& init_method() const { return init_method_; }
   /// Observations rejected by the whitened-residual gate (model.max_whitened_residual).
   int rejected_observations() const { return rejected_observations_; }
+  /// Set when the rig cannot be right (rig_checks.h: the IMU at rest, the initializers' biases and
+  /// gravity, the gyro against the camera's rotation): what is wrong and how to fix it. The run
+  /// should stop there; the estimator does not initialize on such a rig.
+  const std::string& input_problem() const { return input_problem_; }
 
  private:
   struct Prediction {
@@ -102,7 +109,12 @@ class Estimator {
   bool Initialize(const StereoFrame& frame);
   /// Static initialization at the frame; auto: only when the camera agrees that it is still.
   /// `moving`: the IMU (or, auto, the camera) moves.
-  std::optional<InitialState> TryStatic(const StereoFrame& frame, std::string* reason, bool* moving) const;
+  std::optional<InitialState> TryStatic(const StereoFrame& frame, std::string* reason, bool* moving);
+  /// The dynamic initializer's gravity and biases against the rig's limits; an implausible result
+  /// `kImplausibleInits` attempts in a row is an input problem. Empty when plausible.
+  std::string CheckDynamicResult(const DynamicInitResult& result);
+  /// The gyro's rotation against the camera's from the previous frame to this one (RotationCheck).
+  void CheckRotation(const StereoFrame& frame);
   /// Dynamic initialization from the buffered frames ending at this one.
   bool TryDynamic(std::string* reason);
   /// The buffered frames (time order) from t_ns - span_s on.
@@ -134,6 +146,16 @@ class Estimator {
   std::vector<StereoFrame> init_frames_;  ///< frames before initialization (the last few seconds)
   std::string init_method_;
   std::vector<FrameEstimate> earlier_estimates_;
+  RigLimits rig_limits_;                        ///< from the sensor.yaml noise figures (unscaled)
+  /// A frame of the rotation check's span, with the gyro's rotation integrated up to it.
+  struct RotationCheckFrame {
+    StereoFrame frame;
+    Eigen::Vector3d gyro_sum;  ///< the gyro integrated from the first frame kept (IntegratedGyro) [rad]
+  };
+  RotationCheck rotation_check_;
+  std::deque<RotationCheckFrame> rotation_frames_;  ///< the last RotationCheck::kPairSpanS, until it decided
+  int implausible_inits_ = 0;                   ///< dynamic initializations in a row that were implausible
+  std::string input_problem_;
 };
 
 }  // namespace vio

@@ -26,6 +26,8 @@ struct StaticInitResult {
   /// Set when `state` is empty because the IMU moves; a start of the data
   /// with too few samples yet to judge is the normal case, and not this.
   bool moving = false;
+  /// The accelerometer's mean over the still window, when `state` is set (rig_checks.h) [m/s^2].
+  Eigen::Vector3d accel_mean = Eigen::Vector3d::Zero();
 };
 
 /// Looks at the IMU in [t_ns - static_window_s, t_ns]: when it is still

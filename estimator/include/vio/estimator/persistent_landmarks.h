@@ -66,6 +66,9 @@ class PersistentLandmarks {
   PersistentDecision Decide(Timestamp now_ns, const std::vector<PromotionCandidate>& candidates);
   /// Forgets a promoted landmark the policy could not add (no retirement).
   void Release(LandmarkId id) { kept_.erase(id); }
+  /// Forgets the kept landmarks the window no longer has: a solve drops a landmark whose
+  /// observations all failed at a rejected step's end point (Window::Solve), without retirement.
+  void ForgetAbsent(const Window& window);
 
  private:
   struct Kept {

@@ -71,7 +71,8 @@ struct InitReport {
 struct RunResult {
   /// ok: every frame from initialization on estimated, every solve usable,
   /// within the sanity bounds; else the first of: imu_gap (stopped at an IMU
-  /// gap longer than model.max_imu_gap_s), diverged (|p| > 10 km, |v| > 100
+  /// gap longer than model.max_imu_gap_s), bad_input (stopped: the data shows the rig cannot
+  /// be right, e.g. the IMU in wrong units or swapped cameras; rig_checks.h), diverged (|p| > 10 km, |v| > 100
   /// m/s or not finite), failed (an error mid-run), frames_skipped (frames
   /// outside the IMU span by more than max_imu_gap_s), not_initialized (no
   /// frame estimated), late_init (more than kMaxInitWaitS seconds or

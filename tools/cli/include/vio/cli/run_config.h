@@ -12,14 +12,20 @@ namespace vio::tools {
 
 /// Where calibration comes from.
 struct CalibrationOptions {
-  /// Folder holding mav0/{cam0,cam1,imu0}/sensor.yaml; empty = the dataset's own.
+  /// Folder holding mav0/{cam0,cam1,imu0}/sensor.yaml, or Kalibr's camchain-imucam.yaml; empty = the
+  /// dataset's own.
   std::string calibration;
+  /// Kalibr's imu.yaml for a camchain; empty = imu.yaml (or imu-NAME.yaml) beside it.
+  std::string calibration_imu;
 
   template <class V>
   void Visit(V& v) {
     v("calibration", calibration,
-      "folder whose mav0/{cam0,cam1,imu0}/sensor.yaml calibrate the run; empty = the dataset's own "
-      "(required for a ROS bag)");
+      "folder whose mav0/{cam0,cam1,imu0}/sensor.yaml calibrate the run, or Kalibr's camchain-imucam.yaml "
+      "(T_cam_imu, intrinsics, distortion, timeshift_cam_imu); empty = the dataset's own (required for a ROS bag)");
+    v("calibration_imu", calibration_imu,
+      "with a Kalibr camchain as --calibration: Kalibr's imu.yaml (noise densities, random walks, update_rate); "
+      "empty = imu.yaml or imu-NAME.yaml beside camchain-imucam-NAME.yaml");
   }
 };
 

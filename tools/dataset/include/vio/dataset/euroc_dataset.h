@@ -72,6 +72,10 @@ struct EurocDataset {
   std::vector<int> imu_lines;  ///< 1-based line of each sample in imu_file (empty when not read)
   ImuGapReport imu_gaps;
   CameraCalibration cameras[2];
+  /// The camera clock against the IMU's: an image stamped t was taken at IMU time
+  /// t - camera_time_offset_ns (Kalibr's timeshift_cam_imu is its negative; EuRoC's sensor.yaml has
+  /// none: 0). `vio run` moves the frames onto the IMU's clock by it; the prior of an online estimate.
+  Timestamp camera_time_offset_ns = 0;
   std::vector<CameraFrame> frames[2];  ///< cam0, cam1 data.csv rows
   bool has_images = false;             ///< images were checked and every listed one exists
   /// A ROS bag holding the images as messages of `image_topics` (rosbag_dataset.h); empty: the

@@ -25,6 +25,9 @@ class FrameSource {
   virtual StereoFrame Frame(size_t k, const Estimator& estimator) = 0;
   /// Counts for summary.json's "frontend" object (a JSON object).
   virtual std::string ReportJson() const = 0;
+  /// Set when the frames show the input cannot be right (swapped cameras): what is wrong and how to
+  /// fix it. The run stops there.
+  virtual std::string InputProblem() const { return ""; }
 };
 
 /// The front end `frontend` (a FrontendOptions::frontend value) stands for on
@@ -37,5 +40,9 @@ std::string ResolveFrontend(const std::string& frontend, const EurocDataset& dat
 /// std::runtime_error when the dataset lacks what it needs.
 std::unique_ptr<FrameSource> MakeFrameSource(const FrontendOptions& options, const EurocDataset& dataset,
                                              const frontend::StereoRectifier& rectifier);
+
+/// `source` with every frame stamp moved by `shift_ns` onto the IMU's clock (a camera-IMU time
+/// offset: EurocDataset::camera_time_offset_ns, shift = -camera_time_offset_ns); `source` itself when 0.
+std::unique_ptr<FrameSource> ShiftFrameTimes(std::unique_ptr<FrameSource> source, Timestamp shift_ns);
 
 }  // namespace vio::tools

@@ -2,6 +2,7 @@
 // The `features` front end: a dataset's features0 observations (distorted
 // pixels of cam0 and cam1) turned into the estimator's StereoFrames of
 // rectified (u_L, u_R, v) measurements.
+#include <string>
 #include <vector>
 
 #include "vio/frontend/stereo_rectifier.h"
@@ -20,6 +21,9 @@ struct StereoFramesReport {
   int rejected_outside_image = 0;  ///< a pixel outside its image (calibration resolution)
   int unrectifiable = 0;           ///< a pixel that cannot be undistorted
   int observations_off_frames = 0; ///< feature rows whose stamp is no cam0 frame
+  /// Pairs rejected (epipolar or disparity) that pass both with the cameras exchanged (cam0's
+  /// point as cam1's and back): evidence of swapped cameras.
+  int consistent_if_swapped = 0;
 };
 
 /// The StereoFrame of stamp t_ns from that stamp's features (both cameras);
@@ -34,5 +38,11 @@ std::vector<StereoFrame> StereoFramesFromFeatures(const std::vector<FeatureObser
                                                   const std::vector<CameraFrame>& cam0_frames,
                                                   const frontend::StereoRectifier& rectifier,
                                                   double max_epipolar_px, StereoFramesReport* report);
+
+/// Swapped cameras: when at least kSwappedMinPairs stereo pairs were seen and most of them fit the
+/// stereo geometry only with the cameras exchanged (consistent_if_swapped), what is wrong and how to
+/// fix it; empty otherwise.
+inline constexpr int kSwappedMinPairs = 100;
+std::string SwappedCamerasProblem(const StereoFramesReport& report);
 
 }  // namespace vio::tools

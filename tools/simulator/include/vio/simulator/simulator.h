@@ -30,6 +30,7 @@
 #include "vio/simulator/gaps.h"
 #include "vio/simulator/imu.h"
 #include "vio/simulator/render.h"
+#include "vio/simulator/rig_faults.h"
 #include "vio/simulator/scene.h"
 #include "vio/simulator/sensor.h"
 #include "vio/simulator/texture.h"
@@ -92,6 +93,8 @@ struct SimulatorOptions {
   /// uncompressed, as EuRoC's own PNGs are; noisy renderings shrink only to
   /// about 0.6 of that at level 1, and take twice as long to decode.
   int png_compression = 0;
+  /// Measurements written wrong on purpose (IMU units, swapped cameras); none by default.
+  RigFaults faults;
 };
 
 /// Everything simulated, in memory.
