@@ -2,12 +2,14 @@
 
 #include <libdeflate.h>
 
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
@@ -92,55 +94,100 @@ std::optional<std::vector<unsigned char>> ImageData(const std::vector<unsigned c
   }
 }
 
-// The PNG filters reversed on one row of 8-bit grey pixels (one byte per
-// pixel): `up` is the previous row decoded (zeros for the first).
-void UndoSub(const unsigned char* in, unsigned char* out, int width) {
-  unsigned left = 0;
-  for (int x = 0; x < width; ++x) out[x] = static_cast<unsigned char>(left = (in[x] + left) & 0xff);
-}
+// The PNG filters reversed on 8-bit grey pixels (one byte per pixel). Each
+// row is one serial chain (a pixel needs the one left of it decoded), so two
+// rows are decoded together, the second one pixel behind the first: two
+// independent chains, about 1.5x the rate of one on the EuRoC images.
 
-void UndoUp(const unsigned char* in, const unsigned char* up, unsigned char* out, int width) {
-  for (int x = 0; x < width; ++x) out[x] = static_cast<unsigned char>(in[x] + up[x]);
-}
-
-void UndoAverage(const unsigned char* in, const unsigned char* up, unsigned char* out, int width) {
-  unsigned left = 0;
-  for (int x = 0; x < width; ++x) out[x] = static_cast<unsigned char>(left = (in[x] + ((left + up[x]) >> 1)) & 0xff);
-}
-
-/// Paeth's predictor, written so that the compiler selects without branches
-/// (the choice is data-dependent noise): ties go to left, then up, as the
-/// PNG specification says.
-void UndoPaeth(const unsigned char* in, const unsigned char* up, unsigned char* out, int width) {
-  int left = 0, up_left = 0;
-  for (int x = 0; x < width; ++x) {
-    const int above = up[x];
+/// The predictor of filter type F from the decoded left, above and upper-left
+/// pixels; Paeth's written so that the compiler selects without branches (the
+/// choice is data-dependent noise), ties going to left, then above, as the PNG
+/// specification says.
+template <int F>
+int Predict(int left, int above, int up_left) {
+  if constexpr (F == 0) return 0;
+  if constexpr (F == 1) return left;
+  if constexpr (F == 2) return above;
+  if constexpr (F == 3) return (left + above) >> 1;
+  if constexpr (F == 4) {
     const int p_left = std::abs(above - up_left), p_above = std::abs(left - up_left),
               p_up_left = std::abs(left + above - 2 * up_left);
     const int second = p_above <= p_up_left ? above : up_left;
     const int second_distance = p_above <= p_up_left ? p_above : p_up_left;
-    left = (in[x] + (p_left <= second_distance ? left : second)) & 0xff;
+    return p_left <= second_distance ? left : second;
+  }
+  return 0;
+}
+
+/// One row of filter type F; `up` is the previous row decoded (zeros for the first).
+template <int F>
+void UnfilterRow(const unsigned char* in, const unsigned char* up, unsigned char* out, int width) {
+  int left = 0, up_left = 0;
+  for (int x = 0; x < width; ++x) {
+    const int above = up[x];
+    left = (in[x] + Predict<F>(left, above, up_left)) & 0xff;
     out[x] = static_cast<unsigned char>(left);
     up_left = above;
   }
 }
 
-/// The rows of `image` from the inflated, filtered scanlines; false on a filter type PNG does not define.
+/// Two consecutive rows of filter types F0 and F1: pixel x of the first, then pixel x - 1 of the second.
+template <int F0, int F1>
+void UnfilterRowPair(const unsigned char* in0, const unsigned char* in1, const unsigned char* up, unsigned char* out0,
+                     unsigned char* out1, int width) {
+  int left0 = (in0[0] + Predict<F0>(0, up[0], 0)) & 0xff, up_left0 = up[0], left1 = 0, up_left1 = 0;
+  out0[0] = static_cast<unsigned char>(left0);
+  for (int x = 1; x <= width; ++x) {
+    if (x < width) {
+      const int above0 = up[x];
+      left0 = (in0[x] + Predict<F0>(left0, above0, up_left0)) & 0xff;
+      out0[x] = static_cast<unsigned char>(left0);
+      up_left0 = above0;
+    }
+    const int above1 = out0[x - 1];
+    left1 = (in1[x - 1] + Predict<F1>(left1, above1, up_left1)) & 0xff;
+    out1[x - 1] = static_cast<unsigned char>(left1);
+    up_left1 = above1;
+  }
+}
+
+using RowFunction = void (*)(const unsigned char*, const unsigned char*, unsigned char*, int);
+using RowPairFunction = void (*)(const unsigned char*, const unsigned char*, const unsigned char*, unsigned char*,
+                                 unsigned char*, int);
+constexpr int kFilterTypes = 5;
+constexpr std::array<RowFunction, kFilterTypes> kRowFunctions = {UnfilterRow<0>, UnfilterRow<1>, UnfilterRow<2>,
+                                                                 UnfilterRow<3>, UnfilterRow<4>};
+
+template <int F0, int... F1>
+constexpr std::array<RowPairFunction, kFilterTypes> PairsAfter(std::integer_sequence<int, F1...>) {
+  return {UnfilterRowPair<F0, F1>...};
+}
+template <int... F0>
+constexpr std::array<std::array<RowPairFunction, kFilterTypes>, kFilterTypes> AllPairs(std::integer_sequence<int, F0...>) {
+  return {PairsAfter<F0>(std::make_integer_sequence<int, kFilterTypes>())...};
+}
+/// kRowPairFunctions[F0][F1]: the row pair of filter types F0, F1.
+constexpr auto kRowPairFunctions = AllPairs(std::make_integer_sequence<int, kFilterTypes>());
+
+/// The rows of `image` from the inflated, filtered scanlines (each its filter
+/// type, then its pixels); false on a filter type PNG does not define.
 bool Unfilter(const std::vector<unsigned char>& scanlines, cv::Mat* image) {
   const int width = image->cols;
   const std::vector<unsigned char> zeros(static_cast<size_t>(width), 0);
-  for (int y = 0; y < image->rows; ++y) {
-    const unsigned char* in = &scanlines[static_cast<size_t>(y) * (width + 1)];
+  const auto scanline = [&](int y) { return &scanlines[static_cast<size_t>(y) * (static_cast<size_t>(width) + 1)]; };
+  for (int y = 0; y < image->rows;) {
+    const unsigned char* in0 = scanline(y);
     const unsigned char* up = y > 0 ? image->ptr<unsigned char>(y - 1) : zeros.data();
-    unsigned char* out = image->ptr<unsigned char>(y);
-    switch (in[0]) {
-      case 0: std::memcpy(out, in + 1, static_cast<size_t>(width)); break;
-      case 1: UndoSub(in + 1, out, width); break;
-      case 2: UndoUp(in + 1, up, out, width); break;
-      case 3: UndoAverage(in + 1, up, out, width); break;
-      case 4: UndoPaeth(in + 1, up, out, width); break;
-      default: return false;
+    if (in0[0] >= kFilterTypes) return false;
+    if (y + 1 == image->rows) {
+      kRowFunctions[in0[0]](in0 + 1, up, image->ptr<unsigned char>(y), width);
+      return true;
     }
+    const unsigned char* in1 = scanline(y + 1);
+    if (in1[0] >= kFilterTypes) return false;
+    kRowPairFunctions[in0[0]][in1[0]](in0 + 1, in1 + 1, up, image->ptr<unsigned char>(y),
+                                      image->ptr<unsigned char>(y + 1), width);
+    y += 2;
   }
   return true;
 }
