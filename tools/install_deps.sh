@@ -15,12 +15,12 @@ set -euo pipefail
 
 packages_of() {
   case "$1" in
-    build) echo build-essential cmake ninja-build pkg-config libceres-dev libeigen3-dev libopencv-dev libpng-dev \
+    build) echo build-essential cmake ninja-build pkg-config libceres-dev libeigen3-dev libopencv-dev libdeflate-dev \
                 libgoogle-glog-dev libgflags-dev libyaml-cpp-dev librosbag-storage-dev libsensor-msgs-dev ;;
     test) echo libgtest-dev libgmock-dev libbenchmark-dev ;;
     plot) echo python3 python3-numpy python3-matplotlib ;;
     runtime) echo libceres3 libopencv-core406 libopencv-imgproc406 libopencv-imgcodecs406 \
-                  libopencv-features2d406 libopencv-calib3d406 libopencv-video406 libpng16-16 \
+                  libopencv-features2d406 libopencv-calib3d406 libopencv-video406 libdeflate0 \
                   libgoogle-glog0v6 libgflags2.2 libyaml-cpp0.7 \
                   librosbag-storage4d libroscpp-serialization0d librostime1d libcpp-common0d \
                   libconsole-bridge1.0 python3 python3-numpy python3-matplotlib ;;

@@ -15,7 +15,7 @@ PolicyTiming EkfPolicy::Update(const StereoFrame& frame, StateId new_state, Wind
   timing.marginalize_ms = MillisecondsSince(start);
 
   start = std::chrono::steady_clock::now();
-  AddStereoObservations(frame, new_state, options_.model, window);
+  AddStereoObservations(frame, new_state, options_.model, window, options_.policy.ekf_max_landmarks);
   timing.build_ms = MillisecondsSince(start);
 
   start = std::chrono::steady_clock::now();

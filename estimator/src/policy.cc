@@ -23,13 +23,15 @@ std::unique_ptr<Policy> MakePolicy(const EstimatorOptions& options) {
   throw std::invalid_argument("unknown policy '" + name + "'");
 }
 
-int AddStereoObservations(const StereoFrame& frame, StateId state_id, const ModelOptions& model, Window& window) {
+int AddStereoObservations(const StereoFrame& frame, StateId state_id, const ModelOptions& model, Window& window,
+                          int max_landmarks) {
   const State& s = window.state(state_id);
   const Eigen::Isometry3d T_w_b = Eigen::Translation3d(s.p_w_b()) * s.q_w_b();
   const Eigen::Isometry3d T_w_cl = T_w_b * window.stereo().T_b_cl;
   int added = 0;
   for (const StereoObservation& obs : frame.observations) {
     if (!window.HasLandmark(obs.landmark)) {
+      if (max_landmarks > 0 && static_cast<int>(window.landmarks().size()) >= max_landmarks) continue;
       const std::optional<Eigen::Vector3d> p_cl =
           TriangulateRectified(obs.z_px, window.stereo(), model.min_disparity_px);
       if (!p_cl || p_cl->z() > model.max_depth_m) continue;

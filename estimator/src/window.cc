@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
+#include <utility>
 
 #include <glog/logging.h>
 
@@ -254,11 +256,7 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
     options.first_estimate = [this](const double* block) { return first_estimates_->Find(KeyOf(block)); };
   }
   ForgetResidualsOf(leaving);
-  const std::set<ceres::ResidualBlockId> dropped = DropUnevaluableResiduals(blocks);
-  auto& order = options.residual_order;
-  order.erase(std::remove_if(order.begin(), order.end(), [&](ceres::ResidualBlockId id) { return dropped.count(id) > 0; }),
-              order.end());
-  ceres::ResidualBlockId prior = marginalization::MarginalizeBlocks(problem_.get(), blocks, options);
+  const ceres::ResidualBlockId prior = MarginalizeEvaluable(blocks, std::move(options));
   last_prior_rank_deficient_ = false;
   if (prior != nullptr) {
     std::vector<double*> kept;
@@ -301,6 +299,22 @@ void Window::ForgetResidualsOf(const Leaving& leaving) {
   for (auto it = priors_.begin(); it != priors_.end();) {
     it = Touches(*it, leaving) ? priors_.erase(it) : std::next(it);
   }
+}
+
+// The marginalization assembles every residual of `blocks` and fails (throws,
+// the problem untouched) when one does not evaluate finitely: only then are
+// those residuals looked for and dropped, and the marginalization retried.
+ceres::ResidualBlockId Window::MarginalizeEvaluable(const std::vector<double*>& blocks,
+                                                    marginalization::MarginalizationOptions options) {
+  try {
+    return marginalization::MarginalizeBlocks(problem_.get(), blocks, options);
+  } catch (const std::exception&) {  // a failure that no dropped residual explains throws again below
+  }
+  const std::set<ceres::ResidualBlockId> dropped = DropUnevaluableResiduals(blocks);
+  auto& order = options.residual_order;
+  order.erase(std::remove_if(order.begin(), order.end(), [&](ceres::ResidualBlockId id) { return dropped.count(id) > 0; }),
+              order.end());
+  return marginalization::MarginalizeBlocks(problem_.get(), blocks, options);
 }
 
 // A residual that does not evaluate at the current point (a landmark at or

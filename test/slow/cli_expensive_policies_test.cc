@@ -40,6 +40,7 @@ TEST_P(ExpensivePolicies, TrackTheSyntheticFlight) {
   request.show_progress = false;
   request.config.estimator.policy.policy = c.policy;
   request.config.estimator.policy.ekf_landmarks = c.ekf_landmarks;
+  if (c.ekf_landmarks == "keep") request.config.estimator.policy.ekf_max_landmarks = 0;  // the paper's: the whole map
   const RunResult result = RunDataset(request);
   EXPECT_EQ(result.status, "ok");
   // Every frame after static initialization (IMU stillness over 1 s: 20 frames).

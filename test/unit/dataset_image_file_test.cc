@@ -1,5 +1,5 @@
-// ReadGreyImage gives cv::imread's grey pixels for every file, through libpng
-// directly for 8-bit grey PNGs (stored or compressed), and nothing for a file
+// ReadGreyImage gives cv::imread's grey pixels for every file, through its own
+// decoding for 8-bit grey PNGs (stored or compressed), and nothing for a file
 // that is damaged or no image.
 #include <fstream>
 #include <iterator>
@@ -46,11 +46,14 @@ void ExpectSameAsImread(const std::string& path) {
 TEST(ReadGreyImage, GivesImreadsPixelsForEveryKindOfFile) {
   const std::string dir = test::MakeTempDir("image_file");
   const cv::Mat grey = Noise(48, 75, CV_8UC1, 1);
+  const cv::Mat odd = Noise(47, 1, CV_8UC1, 5);  // rows decoded in pairs: an odd count, one pixel per row
   for (int level : {0, 1, 9}) {  // 0: stored, as the EuRoC PNGs
-    const std::string path = dir + "/grey" + std::to_string(level) + ".png";
-    ASSERT_TRUE(cv::imwrite(path, grey, {cv::IMWRITE_PNG_COMPRESSION, level}));
-    ExpectSameAsImread(path);
-    EXPECT_EQ(cv::norm(ReadGreyImage(path), grey, cv::NORM_INF), 0.0);
+    for (const cv::Mat& image : {grey, odd}) {
+      const std::string path = dir + "/grey" + std::to_string(level) + "_" + std::to_string(image.rows) + ".png";
+      ASSERT_TRUE(cv::imwrite(path, image, {cv::IMWRITE_PNG_COMPRESSION, level}));
+      ExpectSameAsImread(path);
+      EXPECT_EQ(cv::norm(ReadGreyImage(path), image, cv::NORM_INF), 0.0);
+    }
   }
   cv::Mat deep;
   Noise(30, 41, CV_8UC1, 2).convertTo(deep, CV_16UC1, 257.0);

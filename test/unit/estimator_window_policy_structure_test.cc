@@ -210,7 +210,10 @@ TEST(PolicyStructure, FixedLagMarginalizesLikeTheMsckf) {
 // is the map seen so far. marginalize_unseen keeps only the frame's.
 TEST(PolicyStructure, EkfMarginalizesThePreviousStateAndKeepsEveryLandmark) {
   const Script& s = TheScript();
-  const std::vector<FrameRecord> records = RunScript(Options("ekf", 1));
+  EstimatorOptions paper = Options("ekf", 1);
+  paper.policy.ekf_landmarks = "keep";
+  paper.policy.ekf_max_landmarks = 0;
+  const std::vector<FrameRecord> records = RunScript(paper);
   Ids map;
   for (int k = 0; k < kFrames; ++k) {
     SCOPED_TRACE("frame " + std::to_string(k));
@@ -223,16 +226,31 @@ TEST(PolicyStructure, EkfMarginalizesThePreviousStateAndKeepsEveryLandmark) {
     EXPECT_EQ(records[k].landmarks, map);
     EXPECT_EQ(records[k].solver_iterations, 1);
   }
-  EstimatorOptions bounded = Options("ekf", 1);
+  EstimatorOptions bounded = paper;
   bounded.policy.ekf_landmarks = "marginalize_unseen";
   const std::vector<FrameRecord> unseen = RunScript(bounded);
+  size_t most_in_a_frame = 0;
   for (int k = 0; k < kFrames; ++k) {
     Ids in_frame;
     for (const auto& [id, life] : s.lifetime) {
       if (life.first <= k && k <= life.second) in_frame.insert(id);
     }
     EXPECT_EQ(unseen[k].landmarks, in_frame) << "frame " << k;
+    most_in_a_frame = std::max(most_in_a_frame, in_frame.size());
   }
+  // ekf_max_landmarks: the map never holds more; a landmark in it is one the frame sees.
+  ASSERT_GT(most_in_a_frame, 2u);
+  EstimatorOptions capped = bounded;
+  capped.policy.ekf_max_landmarks = static_cast<int>(most_in_a_frame) - 1;
+  const std::vector<FrameRecord> limited = RunScript(capped);
+  bool full = false;
+  for (int k = 0; k < kFrames; ++k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    EXPECT_LE(limited[k].landmarks.size(), most_in_a_frame - 1);
+    full = full || limited[k].landmarks.size() == most_in_a_frame - 1;
+    for (const int id : limited[k].landmarks) EXPECT_TRUE(unseen[k].landmarks.count(id) > 0);
+  }
+  EXPECT_TRUE(full);
 }
 
 }  // namespace

@@ -194,15 +194,13 @@ void CsvReader::RequireRows() const {
 }
 
 void TimestampOrder::Check(const CsvReader& reader, Timestamp t_ns) {
-  if (last_t_ns_.has_value()) {
-    const std::string previous =
-        std::to_string(*last_t_ns_) + " on line " + std::to_string(last_line_);
-    if (t_ns == *last_t_ns_ && !allow_equal_) {
+  if (last_t_ns_.has_value() && (t_ns < *last_t_ns_ || (t_ns == *last_t_ns_ && !allow_equal_))) {
+    // The message is built only for a failing row (one row per observation: this runs once per CSV line).
+    const std::string previous = std::to_string(*last_t_ns_) + " on line " + std::to_string(last_line_);
+    if (t_ns == *last_t_ns_) {
       reader.Fail("duplicated timestamp " + std::to_string(t_ns) + " (same as " + previous + ")");
     }
-    if (t_ns < *last_t_ns_) {
-      reader.Fail("non-increasing timestamp " + std::to_string(t_ns) + " (after " + previous + ")");
-    }
+    reader.Fail("non-increasing timestamp " + std::to_string(t_ns) + " (after " + previous + ")");
   }
   last_t_ns_ = t_ns;
   last_line_ = reader.line();

@@ -11,9 +11,12 @@
 //                taken on the whole cost (Theorem 4.3.2); the iterated EKF
 //                takes steps to convergence (at most max_iterations).
 // With ekf_landmarks=keep (the paper) the landmarks stay forever: the prior
-// grows with the map and each step costs O(map^3). marginalize_unseen
-// marginalizes, after the update, the landmarks the frame did not observe
-// (in covariance form: deleting them from the state), bounding the cost.
+// grows with the map and each step costs O(map^3). marginalize_unseen (the
+// default) marginalizes, after the update, the landmarks the frame did not
+// observe (in covariance form: deleting them from the state).
+// ekf_max_landmarks bounds the map: new landmarks enter only while it has
+// room (a KLT front end sees 150-300 per frame: without the bound the dense
+// step over all of them is slower than real time).
 #include <set>
 
 #include "vio/estimator/policy.h"

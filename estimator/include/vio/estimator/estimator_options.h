@@ -17,7 +17,10 @@ struct PolicyOptions {
   /// What happens to landmarks seen by the state that leaves an SWF window.
   std::string swf_landmarks = "marginalize";
   /// What EKF-SLAM does with landmarks the newest frame did not observe.
-  std::string ekf_landmarks = "keep";
+  std::string ekf_landmarks = "marginalize_unseen";
+  /// EKF-SLAM: most landmarks in the state; a frame's new landmarks enter
+  /// while there is room (0: no limit) [count].
+  int ekf_max_landmarks = 20;
   int keyframe_temporal_window = 3;  ///< keyframe policy: most recent frames always kept [frames]
   double keyframe_overlap = 0.7;     ///< keyframe policy: new keyframe below this shared-landmark fraction []
   /// Frames with fewer stereo observations are tracking loss: not used,
@@ -42,6 +45,10 @@ struct PolicyOptions {
       "ekf, iekf: every landmark stays in the state (keep, the paper's EKF-SLAM; cost grows with the map) or "
       "those the newest frame did not observe are marginalized after the update (marginalize_unseen, bounded)",
       {"keep", "marginalize_unseen"});
+    v("ekf_max_landmarks", ekf_max_landmarks,
+      "ekf, iekf: most landmarks in the state (the map); a frame's new landmarks enter, in the frame's order, "
+      "while there is room; 0 = no limit (each step costs O(map^3)) [count]",
+      AtLeast(0));
     v("keyframe_temporal_window", keyframe_temporal_window,
       "keyframe policy: the most recent frames, always kept [frames]", AtLeast(1));
     v("keyframe_overlap", keyframe_overlap,

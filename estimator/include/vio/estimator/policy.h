@@ -48,9 +48,11 @@ inline double MillisecondsSince(std::chrono::steady_clock::time_point start) {
 
 /// Adds the frame's observations: of landmarks already in the window, and of
 /// new landmarks stereo-triangulated from `state`'s current pose (those with
-/// too small a disparity or too large a depth are skipped and counted).
-/// Returns the number of new landmarks.
-int AddStereoObservations(const StereoFrame& frame, StateId state, const ModelOptions& model, Window& window);
+/// too small a disparity or too large a depth are skipped and counted), in
+/// the frame's order while the window holds fewer than `max_landmarks` (0: no
+/// limit). Returns the number of new landmarks.
+int AddStereoObservations(const StereoFrame& frame, StateId state, const ModelOptions& model, Window& window,
+                          int max_landmarks = 0);
 
 /// The sliding-window frame step: the frame's observations in (new
 /// landmarks stereo-triangulated), IMU factors refreshed, then Gauss-Newton

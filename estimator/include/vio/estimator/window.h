@@ -23,6 +23,7 @@
 #include "vio/estimator/imu_preintegration.h"
 #include "vio/estimator/solve_control.h"
 #include "vio/estimator/types.h"
+#include "vio/marginalization/marginalizer.h"
 
 namespace vio {
 
@@ -236,6 +237,9 @@ class Window {
   void ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const;
   void ForgetResidualsOf(const Leaving& leaving);
   std::set<ceres::ResidualBlockId> DropUnevaluableResiduals(const std::vector<double*>& blocks);
+  /// MarginalizeBlocks, after DropUnevaluableResiduals only when it fails: the prior, or null.
+  ceres::ResidualBlockId MarginalizeEvaluable(const std::vector<double*>& blocks,
+                                              marginalization::MarginalizationOptions options);
   /// The observations whose residual does not evaluate (finitely) at the current values, by ids.
   std::vector<ObservationKey> UnevaluableObservations() const;
   /// Drops `observations`, and a landmark left unobserved that no prior holds.
