@@ -66,8 +66,8 @@ class BagImageReader {
 /// at a time from the folder). Throws DatasetError / std::runtime_error.
 void WriteBag(const EurocDataset& dataset, const std::string& path, const BagTopics& topics);
 
-/// Writes a bag's dataset (ReadBag, with calibration set) as an ASL folder,
-/// images as PNG.
+/// Writes a bag's dataset (ReadBag or ReadRos2Bag, with calibration set) as
+/// an ASL folder, images as PNG.
 void WriteAslFromBag(const EurocDataset& dataset, const std::string& root);
 
 }  // namespace vio::tools
