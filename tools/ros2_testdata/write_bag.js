@@ -5,12 +5,14 @@
 // a writer independent of vio's own, for vio's ROS 2 reader tests.
 //
 // usage: node write_bag.js --asl=DIR --out=FILE [--compression=none|zstd|lz4]
-//          [--image=mono8|rgb8|bgr8|bgra8|png] [--groundtruth=pose|transform|odometry]
+//          [--image=mono8|rgb8|bgr8|bgra8|png|jpeg] [--groundtruth=pose|transform|odometry]
 //          [--frames=N] [--format=mcap|jsonl]
 //   mcap:  an MCAP file, chunks compressed as asked.
 //   jsonl: one JSON object per message {topic, type, t (ns, string), cdr (base64)}, in
 //          stamp order, for write_db3.py (rosbag2's sqlite3 layout from python3's sqlite3).
-// Topics: /cam0/image_raw, /cam1/image_raw, /imu0, /groundtruth (EuRoC's).
+// Raw images are the PNGs decoded here; png and jpeg are CompressedImages of the
+// image files (jpeg: the .jpg beside each .png). Topics: /cam0/image_raw,
+// /cam1/image_raw, /imu0, /groundtruth (EuRoC's).
 "use strict";
 const fs = require("fs");
 const path = require("path");
@@ -79,6 +81,9 @@ function stamp(ns) {
 function imageMessage(file, ns, encoding, frameId) {
   const header = { stamp: stamp(ns), frame_id: frameId };
   if (encoding === "png") return { header, format: "png", data: new Uint8Array(fs.readFileSync(file)) };
+  if (encoding === "jpeg") {  // the image's .jpg twin, as written beside the .png
+    return { header, format: "jpeg", data: new Uint8Array(fs.readFileSync(file.replace(/\.png$/, ".jpg"))) };
+  }
   const { width, height, pixels } = decodeGreyPng(file);
   const channels = { mono8: 1, rgb8: 3, bgr8: 3, bgra8: 4 }[encoding];
   if (!channels) throw new Error(`unknown --image=${encoding}`);
@@ -136,7 +141,8 @@ function groundTruthRows(folder) {
 // Every message of the folder: {topic, type, t (BigInt ns), make()} in stamp order.
 function messages(a) {
   const mav0 = path.join(a.asl, "mav0"), list = [];
-  const imageType = a.image === "png" ? "sensor_msgs/msg/CompressedImage" : "sensor_msgs/msg/Image";
+  const compressed = a.image === "png" || a.image === "jpeg";
+  const imageType = compressed ? "sensor_msgs/msg/CompressedImage" : "sensor_msgs/msg/Image";
   for (const cam of [0, 1]) {
     let rows = csv(path.join(mav0, `cam${cam}`, "data.csv"));
     if (Number(a.frames) > 0) rows = rows.slice(0, Number(a.frames));
