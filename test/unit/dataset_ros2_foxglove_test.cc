@@ -1,7 +1,8 @@
 // The ROS 2 readers against recordings an independent writer made:
 // tools/ros2_testdata/write_bag.js (Foxglove's @mcap/core and
 // @foxglove/rosmsg2-serialization, versions pinned by its package-lock.json)
-// writes a small ASL folder as MCAP with every chunk compression, image
+// writes a small ASL folder as MCAP with every chunk compression (and
+// without chunks), image
 // encoding and ground-truth type, and as CDR that write_db3.py (python3's
 // sqlite3) puts in rosbag2 .db3 folders of Humble's and Jazzy's layouts, one
 // and three files. Each reads back to the folder's data exactly.
@@ -114,7 +115,8 @@ TEST(Ros2Foxglove, RecordingsOfAnIndependentWriterReadBackExactly) {
   };
   const Variant variants[] = {{"none", "mono8", "pose"},     {"zstd", "rgb8", "transform"},
                               {"lz4", "bgra8", "odometry"},  {"zstd", "bgr8", "pose"},
-                              {"lz4", "png", "transform"},   {"none", "jpeg", "odometry"}};
+                              {"lz4", "png", "transform"},   {"none", "jpeg", "odometry"},
+                              {"unchunked", "mono8", "pose"}};
   for (const Variant& v : variants) {
     const std::string out = dir + "/" + v.compression + "_" + v.image + "_" + v.groundtruth + ".mcap";
     RunTool(std::string("node write_bag.js --asl=") + asl.root + " --out=" + out + " --compression=" + v.compression +

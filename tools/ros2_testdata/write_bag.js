@@ -4,10 +4,10 @@
 // chunks compressed by @foxglove/wasm-zstd or lz4js):
 // a writer independent of vio's own, for vio's ROS 2 reader tests.
 //
-// usage: node write_bag.js --asl=DIR --out=FILE [--compression=none|zstd|lz4]
+// usage: node write_bag.js --asl=DIR --out=FILE [--compression=none|zstd|lz4|unchunked]
 //          [--image=mono8|rgb8|bgr8|bgra8|png|jpeg] [--groundtruth=pose|transform|odometry]
 //          [--frames=N] [--format=mcap|jsonl]
-//   mcap:  an MCAP file, chunks compressed as asked.
+//   mcap:  an MCAP file, chunks compressed as asked (unchunked: messages outside chunks).
 //   jsonl: one JSON object per message {topic, type, t (ns, string), cdr (base64)}, in
 //          stamp order, for write_db3.py (rosbag2's sqlite3 layout from python3's sqlite3).
 // Raw images are the PNGs decoded here; png and jpeg are CompressedImages of the
@@ -169,7 +169,7 @@ function serializer(type) {
 }
 
 async function compressor(kind) {
-  if (kind === "none") return undefined;
+  if (kind === "none" || kind === "unchunked") return undefined;
   if (kind === "zstd") {
     const zstd = require("@foxglove/wasm-zstd");
     await zstd.isLoaded;
@@ -192,7 +192,8 @@ class FileSink {
 
 async function writeMcap(a, list) {
   const sink = new FileSink(a.out);
-  const writer = new McapWriter({ writable: sink, compressChunk: await compressor(a.compression), chunkSize: 1 << 20 });
+  const writer = new McapWriter({ writable: sink, compressChunk: await compressor(a.compression), chunkSize: 1 << 20,
+                                  useChunks: a.compression !== "unchunked" });
   await writer.start({ profile: "ros2", library: "vio-ros2-testdata" });
   const channels = new Map(), writers = new Map();
   for (const m of list) {

@@ -19,13 +19,13 @@ struct CalibrationOptions {
   void Visit(V& v) {
     v("calibration", calibration,
       "folder whose mav0/{cam0,cam1,imu0}/sensor.yaml calibrate the run; empty = the dataset's own "
-      "(required for a ROS bag)");
+      "(required for a ROS 1 bag or ROS 2 recording)");
   }
 };
 
 struct RunConfig {
   CalibrationOptions calibration;
-  BagTopics bag;  ///< topics of a ROS bag given as --dataset
+  BagTopics bag;  ///< topics of a ROS 1 bag or ROS 2 recording given as --dataset
   FrontendOptions frontend;
   EstimatorOptions estimator;
 };
