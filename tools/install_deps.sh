@@ -5,7 +5,8 @@
 #
 # usage: install_deps.sh [GROUP...]   (default: build test plot)
 #   build    compilers, CMake, Ninja and the -dev packages `vio` builds against
-#   test     GoogleTest, GoogleMock, Google Benchmark (the suite)
+#   test     GoogleTest, GoogleMock, Google Benchmark (the suite); node and npm, and
+#            tools/ros2_testdata's pinned packages (npm ci: the ROS 2 tests' independent writer)
 #   plot     Python 3 with numpy and matplotlib (tools/plot_sweep.py)
 #   runtime  the shared libraries `vio` loads, and plot (the Docker runtime stage)
 #   docker   the Docker engine and debootstrap (tools/docker_test.sh)
@@ -16,27 +17,41 @@ set -euo pipefail
 packages_of() {
   case "$1" in
     build) echo build-essential cmake ninja-build pkg-config libceres-dev libeigen3-dev libopencv-dev libdeflate-dev \
-                libgoogle-glog-dev libgflags-dev libyaml-cpp-dev librosbag-storage-dev libsensor-msgs-dev ;;
-    test) echo libgtest-dev libgmock-dev libbenchmark-dev ;;
+                libgoogle-glog-dev libgflags-dev libyaml-cpp-dev librosbag-storage-dev libsensor-msgs-dev \
+                libzstd-dev liblz4-dev libsqlite3-dev zlib1g-dev ;;
+    test) echo libgtest-dev libgmock-dev libbenchmark-dev "$(command -v node > /dev/null || echo nodejs npm)" ;;
     plot) echo python3 python3-numpy python3-matplotlib ;;
     runtime) echo libceres3 libopencv-core406 libopencv-imgproc406 libopencv-imgcodecs406 \
                   libopencv-features2d406 libopencv-calib3d406 libopencv-video406 libdeflate0 \
                   libgoogle-glog0v6 libgflags2.2 libyaml-cpp0.7 \
                   librosbag-storage4d libroscpp-serialization0d librostime1d libcpp-common0d \
-                  libconsole-bridge1.0 python3 python3-numpy python3-matplotlib ;;
+                  libconsole-bridge1.0 libzstd1 liblz4-1 libsqlite3-0 zlib1g python3 python3-numpy python3-matplotlib ;;
     docker) echo docker.io debootstrap ;;
     slurm) echo slurm-wlm munge ;;
     *) echo "install_deps: unknown group '$1' (build, test, plot, runtime, docker, slurm)" >&2; return 1 ;;
   esac
 }
 
+# The test group's node packages (tools/ros2_testdata/package-lock.json, exact
+# versions) into tools/ros2_testdata/node_modules, when missing or older than the lock file.
+install_node_packages() {
+  local dir
+  dir="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/ros2_testdata"
+  [ -d "$dir/node_modules" ] && [ "$dir/node_modules" -nt "$dir/package-lock.json" ] && return 0
+  command -v npm >/dev/null || { echo "install_deps: no npm to install $dir's packages" >&2; return 1; }
+  echo "install_deps: npm ci in $dir" >&2
+  (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error >&2) && touch "$dir/node_modules"
+}
+
 groups=("$@")
 [ ${#groups[@]} -eq 0 ] && groups=(build test plot)
 packages=()
+node_packages=0
 for group in "${groups[@]}"; do
   list="$(packages_of "$group")"
   read -r -a words <<< "$list"
   packages+=("${words[@]}")
+  [ "$group" = test ] && node_packages=1
 done
 
 missing=()
@@ -45,7 +60,10 @@ for pkg in "${packages[@]}"; do
     missing+=("$pkg")
   fi
 done
-[ ${#missing[@]} -eq 0 ] && exit 0
+if [ ${#missing[@]} -eq 0 ]; then
+  [ "$node_packages" -eq 0 ] || install_node_packages
+  exit 0
+fi
 
 echo "install_deps: installing ${missing[*]} (and what they depend on)" >&2
 SUDO=""
@@ -80,3 +98,4 @@ if ! $SUDO apt-get install -y -qq --no-install-recommends -o APT::Status-Fd=3 "$
 fi
 rm -f "$log"
 echo "install_deps: done" >&2
+[ "$node_packages" -eq 0 ] || install_node_packages

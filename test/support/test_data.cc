@@ -22,11 +22,14 @@ std::string RandomSuffix() {
 
 }  // namespace
 
+std::string SourceDir() {
+  const char* src = std::getenv("VIO_SOURCE_DIR");
+  return (src != nullptr && *src) ? src : VIO_DEFAULT_SOURCE_DIR;
+}
+
 std::string DataDir() {
   if (const char* env = std::getenv("VIO_DATA_DIR"); env != nullptr && *env) return env;
-  const char* src = std::getenv("VIO_SOURCE_DIR");
-  const std::string root = (src != nullptr && *src) ? src : VIO_DEFAULT_SOURCE_DIR;
-  return root + "/../shared/data";
+  return SourceDir() + "/../shared/data";
 }
 
 std::string EurocSequence(const std::string& name) { return DataDir() + "/euroc/" + name; }

@@ -11,6 +11,9 @@
 
 namespace vio::test {
 
+/// The project's source folder ($VIO_SOURCE_DIR, else where it was built from).
+std::string SourceDir();
+
 /// The real-data root ($VIO_DATA_DIR or <project>/../shared/data).
 std::string DataDir();
 

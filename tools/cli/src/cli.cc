@@ -113,8 +113,9 @@ const std::vector<Subcommand>& Subcommands() {
        "vio sweep --datasets=DIR,... --policies=swf,... --window_sizes=5,10,... --output_dir=DIR [--jobs=N] "
        "[--config=FILE] [--extra_flags=\"--init=groundtruth ...\"] [--emit_jobs | --collect_only]",
        &SweepMain, {"output_dir", "config"}, /*takes_run_config=*/true},
-      {"convert", "an ASL folder with images to a ROS 1 bag, or a bag to an ASL folder",
-       "vio convert --input=DIR_OR_BAG --output=BAG_OR_DIR [--calibration=DIR] [--cam0_topic=/cam0/image_raw ...]",
+      {"convert", "an ASL folder with images to a ROS 1 bag or ROS 2 recording, or back to an ASL folder",
+       "vio convert --input=DIR_OR_BAG --output=BAG_OR_DIR [--storage=mcap|sqlite3] [--compression=zstd|lz4|none] "
+       "[--calibration=DIR] [--cam0_topic=/cam0/image_raw ...]",
        &ConvertMain, {}, /*takes_run_config=*/true},
       {"imagestats", "grey level, contrast, gradient, corner and KLT statistics of stereo image sequences, as a table",
        "vio imagestats --datasets=DIR,... [--max_frames=200] [--config=FILE]", &ImageStatsMain, {"config", "datasets"},

@@ -7,7 +7,9 @@
 #include "vio/cli/run.h"
 #include "vio/cli/stop_signal.h"
 
-DEFINE_string(dataset, "", "EuRoC ASL dataset folder (holding mav0/) with features0/data.csv or images");
+DEFINE_string(dataset, "",
+              "EuRoC ASL dataset folder (holding mav0/) with features0/data.csv or images, a ROS 1 bag (FILE.bag) "
+              "or a ROS 2 recording (FILE.mcap, FILE.db3 or a bag folder with metadata.yaml; with --calibration)");
 DEFINE_bool(output_covariance, false,
             "write covariance.csv: per frame, the newest state's marginal covariance (pose 6x6 upper triangle, "
             "velocity and bias variances) from the window's information");

@@ -22,6 +22,7 @@
 #include "vio/dataset/groundtruth_init.h"
 #include "vio/dataset/kalibr_calibration.h"
 #include "vio/dataset/observations_csv.h"
+#include "vio/dataset/ros2_dataset.h"
 #include "vio/dataset/rosbag_dataset.h"
 
 namespace vio::tools {
@@ -48,12 +49,14 @@ void ApplyCalibration(const CalibrationOptions& options, EurocDataset* dataset) 
 }
 
 EurocDataset ReadRunDataset(const RunRequest& request) {
-  if (IsBagPath(request.dataset_dir)) {
+  const bool ros2 = IsRos2BagPath(request.dataset_dir);
+  if (ros2 || IsBagPath(request.dataset_dir)) {
     if (request.config.calibration.calibration.empty()) {
-      throw std::runtime_error(request.dataset_dir + ": a ROS bag carries no calibration: give --calibration=DIR "
-                               "(a folder with mav0/{cam0,cam1,imu0}/sensor.yaml)");
+      throw std::runtime_error(request.dataset_dir + ": a ROS recording carries no calibration: give "
+                               "--calibration=DIR (a folder with mav0/{cam0,cam1,imu0}/sensor.yaml)");
     }
-    EurocDataset dataset = ReadBag(request.dataset_dir, request.config.bag);
+    EurocDataset dataset = ros2 ? ReadRos2Bag(request.dataset_dir, request.config.bag)
+                                : ReadBag(request.dataset_dir, request.config.bag);
     ApplyCalibration(request.config.calibration, &dataset);
     return dataset;
   }

@@ -17,6 +17,7 @@
 #include "vio/frontend/track_drawing.h"
 #include "pair_pipeline.h"
 #include "vio/dataset/image_file.h"
+#include "vio/dataset/ros2_dataset.h"
 #include "vio/dataset/rosbag_dataset.h"
 
 namespace vio::tools {
@@ -69,7 +70,12 @@ class ImageFrameSource final : public FrameSource {
     for (int i = 0; i < 2; ++i) {
       filenames_[i].reserve(dataset.frames[i].size());
       for (const CameraFrame& f : dataset.frames[i]) filenames_[i].push_back(f.filename);
-      if (!dataset.image_bag.empty()) bag_readers_[i].emplace(dataset.image_bag, dataset.image_topics[i]);
+      if (dataset.image_bag.empty()) continue;
+      if (IsRos2BagPath(dataset.image_bag)) {
+        ros2_readers_[i].emplace(dataset.image_bag, dataset.image_topics[i]);
+      } else {
+        bag_readers_[i].emplace(dataset.image_bag, dataset.image_topics[i]);
+      }
     }
     PairFrames(dataset);
     if (!debug_dir_.empty()) std::filesystem::create_directories(debug_dir_);
@@ -151,6 +157,10 @@ class ImageFrameSource final : public FrameSource {
       *image = bag_readers_[camera]->Read(row);
       return;
     }
+    if (ros2_readers_[camera]) {
+      *image = ros2_readers_[camera]->Read(row);
+      return;
+    }
     const std::string path = mav0_ + "/cam" + std::to_string(camera) + "/data/" + filenames_[camera][row];
     *image = ReadGreyImage(path);
     if (image->empty()) throw std::runtime_error(path + ": cannot read the image");
@@ -169,7 +179,8 @@ class ImageFrameSource final : public FrameSource {
   std::unique_ptr<frontend::StereoFrontend> frontend_;
   frontend::TrackDrawer drawer_;
   std::vector<std::string> filenames_[2];
-  std::optional<BagImageReader> bag_readers_[2];  ///< images from a ROS bag: one sequential reader per camera
+  std::optional<BagImageReader> bag_readers_[2];  ///< images from a ROS 1 bag: one sequential reader per camera
+  std::optional<Ros2ImageReader> ros2_readers_[2];  ///< or from a ROS 2 recording
   std::vector<Pair> pairs_;
   int unpaired_ = 0;
   double load_ms_ = 0;          ///< waiting for images (wall clock)

@@ -1,7 +1,7 @@
 #pragma once
 // The image front ends (brisk, klt) as a FrameSource: stereo pairs read
-// lazily, one per frame, from <root>/mav0/cam{0,1}/data/ or from the ROS bag
-// the dataset was read from.
+// lazily, one per frame, from <root>/mav0/cam{0,1}/data/ or from the ROS 1
+// bag or ROS 2 recording the dataset was read from.
 #include <memory>
 
 #include "vio/dataset/frame_source.h"

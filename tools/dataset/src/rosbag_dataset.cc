@@ -13,6 +13,8 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 
+#include "vio/dataset/ros2_dataset.h"
+
 namespace vio::tools {
 namespace {
 
@@ -317,10 +319,16 @@ void WriteAslFromBag(const EurocDataset& dataset, const std::string& root) {
   for (int camera = 0; camera < 2; ++camera) {
     const std::string folder = root + "/mav0/cam" + std::to_string(camera) + "/data/";
     std::filesystem::create_directories(folder);
-    BagImageReader reader(dataset.image_bag, dataset.image_topics[camera]);
+    std::optional<BagImageReader> ros1;
+    std::optional<Ros2ImageReader> ros2;
+    if (IsRos2BagPath(dataset.image_bag)) {
+      ros2.emplace(dataset.image_bag, dataset.image_topics[camera]);
+    } else {
+      ros1.emplace(dataset.image_bag, dataset.image_topics[camera]);
+    }
     for (size_t k = 0; k < dataset.frames[camera].size(); ++k) {
       const std::string file = folder + dataset.frames[camera][k].filename;
-      if (!cv::imwrite(file, reader.Read(k))) throw DatasetError(file + ": cannot write the image");
+      if (!cv::imwrite(file, ros2 ? ros2->Read(k) : ros1->Read(k))) throw DatasetError(file + ": cannot write the image");
     }
   }
 }

@@ -22,7 +22,7 @@ struct CalibrationOptions {
   void Visit(V& v) {
     v("calibration", calibration,
       "folder whose mav0/{cam0,cam1,imu0}/sensor.yaml calibrate the run, or Kalibr's camchain-imucam.yaml "
-      "(T_cam_imu, intrinsics, distortion, timeshift_cam_imu); empty = the dataset's own (required for a ROS bag)");
+      "(T_cam_imu, intrinsics, distortion, timeshift_cam_imu); empty = the dataset's own (required for a ROS 1 bag or ROS 2 recording)");
     v("calibration_imu", calibration_imu,
       "with a Kalibr camchain as --calibration: Kalibr's imu.yaml (noise densities, random walks, update_rate); "
       "empty = imu.yaml or imu-NAME.yaml beside camchain-imucam-NAME.yaml");
@@ -31,7 +31,7 @@ struct CalibrationOptions {
 
 struct RunConfig {
   CalibrationOptions calibration;
-  BagTopics bag;  ///< topics of a ROS bag given as --dataset
+  BagTopics bag;  ///< topics of a ROS 1 bag or ROS 2 recording given as --dataset
   FrontendOptions frontend;
   EstimatorOptions estimator;
 };

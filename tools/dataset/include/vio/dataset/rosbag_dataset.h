@@ -26,11 +26,14 @@ struct BagTopics {
 
   template <class V>
   void Visit(V& v) {
-    v("cam0_topic", cam0_topic, "ROS bag input: left camera topic (sensor_msgs/Image, mono8)");
-    v("cam1_topic", cam1_topic, "ROS bag input: right camera topic (sensor_msgs/Image, mono8)");
+    v("cam0_topic", cam0_topic,
+      "ROS bag input: left camera topic (sensor_msgs/Image, mono8; ROS 2 also rgb8, bgr8, rgba8, bgra8 and "
+      "CompressedImage png or jpeg)");
+    v("cam1_topic", cam1_topic, "ROS bag input: right camera topic (as cam0_topic)");
     v("imu_topic", imu_topic, "ROS bag input: IMU topic (sensor_msgs/Imu)");
     v("groundtruth_topic", groundtruth_topic,
-      "ROS bag input: optional ground-truth topic (geometry_msgs/PoseStamped or TransformStamped)");
+      "ROS bag input: optional ground-truth topic (geometry_msgs/PoseStamped or TransformStamped; ROS 2 also "
+      "nav_msgs/Odometry)");
   }
 };
 
@@ -66,8 +69,8 @@ class BagImageReader {
 /// at a time from the folder). Throws DatasetError / std::runtime_error.
 void WriteBag(const EurocDataset& dataset, const std::string& path, const BagTopics& topics);
 
-/// Writes a bag's dataset (ReadBag, with calibration set) as an ASL folder,
-/// images as PNG.
+/// Writes a bag's dataset (ReadBag or ReadRos2Bag, with calibration set) as
+/// an ASL folder, images as PNG.
 void WriteAslFromBag(const EurocDataset& dataset, const std::string& root);
 
 }  // namespace vio::tools
