@@ -244,6 +244,18 @@ void FinishEstimates(Estimator& estimator, RunOutput& output, RunResult* result)
   }
 }
 
+// --trajectory=smoothed: the offline refinement of every frame replaces the last estimates.
+void RefineEstimates(const Estimator& estimator, RunOutput& output, RunResult* result) {
+  const std::vector<FrameEstimate> refined = estimator.Refine(&result->refinement);
+  if (!refined.empty()) {
+    output.ReplaceEstimates(refined);
+    return;
+  }
+  if (!result->refinement.ran) return;
+  result->problems.push_back("refinement: no usable solution (the frames' last estimates are kept)");
+  result->status = "solver_failure";
+}
+
 // A run that waited more than kMaxInitWaitS or kMaxInitWaitFraction of its
 // frames before its first estimate lost that part of the trajectory: not ok.
 void CheckLateInit(RunResult* result) {
@@ -359,6 +371,8 @@ RunResult RunDataset(const RunRequest& requested) {
     throw std::runtime_error(request.dataset_dir + ": --init=groundtruth but the dataset has no ground truth");
   }
   Estimator estimator(request.config.estimator, dataset.imu_calibration, rectifier.rectified());
+  const bool refine = request.trajectory == "smoothed" && request.config.estimator.policy.policy != "batch";
+  if (refine) estimator.KeepMeasurements();
   RunOutput output(request.output_dir);
   RunResult result;
   result.frames = static_cast<int>(source->size());
@@ -375,6 +389,7 @@ RunResult RunDataset(const RunRequest& requested) {
   // Every frame's state as last estimated, whether the run finished or stopped.
   if (request.trajectory == "smoothed") output.ReplaceEstimates(estimator.LastEstimates());
   if (result.status == "ok") FinishEstimates(estimator, output, &result);
+  if (refine && result.status == "ok") RefineEstimates(estimator, output, &result);
   ReportFramesOutsideImu(dataset, *source, request.config.estimator.model.max_imu_gap_s, &result);
   result.processing_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   FinishStatus(estimator, &result);
@@ -382,7 +397,7 @@ RunResult RunDataset(const RunRequest& requested) {
   result.real_time_factor = result.processing_s > 0 ? result.dataset_duration_s / result.processing_s : 0.0;
   Evaluate(dataset, request, output, &result);
   output.WriteTrajectory();
-  output.WriteTiming();
+  output.WriteTiming(result.refinement);
   result.peak_memory_mb = PeakMemoryMb();
   output.WriteSummary(result, source->ReportJson(), request, result.peak_memory_mb, estimator.waiting_reason());
   output.WriteConfig(RunConfigToYaml(request.config));

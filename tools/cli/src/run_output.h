@@ -22,7 +22,8 @@ class RunOutput {
   const std::vector<GroundTruthState>& trajectory() const { return trajectory_; }
 
   void WriteTrajectory() const;
-  void WriteTiming() const;
+  /// timing.csv; a refinement that ran adds a last comment line with its cost.
+  void WriteTiming(const RefinementReport& refinement) const;
   void WriteSummary(const RunResult& result, const std::string& frontend_json, const RunRequest& request,
                     double peak_memory_mb, const std::string& waiting_reason) const;
   void WriteConfig(const std::string& yaml) const;
