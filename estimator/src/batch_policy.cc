@@ -5,6 +5,8 @@
 
 #include <glog/logging.h>
 
+#include "vio/estimator/refinement.h"
+
 namespace vio {
 PolicyTiming BatchPolicy::Update(const StereoFrame& frame, StateId new_state, Window& window) {
   PolicyTiming timing;
@@ -19,7 +21,7 @@ PolicyTiming BatchPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
 
   if (++frames_ % std::max(1, options_.batch.batch_solve_every) != 0) return timing;
   start = std::chrono::steady_clock::now();
-  timing.solver_iterations = window.Solve(options_.solver).iterations;
+  timing.solver_iterations = window.SolveSparse(options_.solver).iterations;
   timing.solve_ms = MillisecondsSince(start);
 
   start = std::chrono::steady_clock::now();
@@ -37,8 +39,8 @@ void BatchPolicy::FreezeOld(Window& window) {
     window.SetStateConstant(oldest, true);
     for (const auto& [id, landmark] : window.landmarks()) {
       if (!landmark.observed_from.count(oldest)) continue;
-      const bool seen_by_active = std::any_of(landmark.observed_from.begin(), landmark.observed_from.end(),
-                                              [&](StateId s) { return active_.count(s) > 0; });
+      // The active states are the newest: the landmark's newest observer decides.
+      const bool seen_by_active = active_.count(*landmark.observed_from.rbegin()) > 0;
       if (!seen_by_active) window.SetLandmarkConstant(id, true);
     }
   }
@@ -47,16 +49,7 @@ void BatchPolicy::FreezeOld(Window& window) {
 bool BatchPolicy::Finish(Window& window) {
   for (const auto& [id, state] : window.states()) window.SetStateConstant(id, false);
   for (const auto& [id, landmark] : window.landmarks()) window.SetLandmarkConstant(id, false);
-  SolverOptions solver = options_.solver;
-  solver.max_iterations = options_.batch.batch_final_iterations;
-  // Ceres' own tolerance: the default function_tolerance (1e-3) is set for
-  // the Gauss-Newton steps of a window, not for the final solve of everything.
-  solver.function_tolerance = 1e-6;
-  // Bounded by iterations only (a configured wall-time bound is for a window's
-  // solves): the final estimate does not depend on machine load.
-  solver.max_solver_time_s = 0;
-  solver.linear_solver = "sparse_full";
-  const SolveReport report = window.Solve(solver);
+  const SolveReport report = SolveWhole(window, options_);
   LOG(INFO) << "batch: final solve over " << window.states().size() << " states and " << window.landmarks().size()
             << " landmarks, " << report.iterations << " iterations, cost " << report.initial_cost << " -> "
             << report.final_cost;

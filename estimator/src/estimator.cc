@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <iomanip>
+#include <map>
 #include <sstream>
 
 #include <glog/logging.h>
@@ -56,7 +57,9 @@ FrameEstimate Estimator::ProcessFrame(const StereoFrame& frame) {
   }
   timing.propagate_ms = MillisecondsSince(start);
   const bool tracked = tracking_.Observe(frame.t_ns, static_cast<int>(frame.observations.size()));
-  timing.policy = policy_->Update(tracked ? GateObservations(frame) : StereoFrame{frame.t_ns, {}}, last_state_, window_);
+  const StereoFrame used = tracked ? GateObservations(frame) : StereoFrame{frame.t_ns, {}};
+  if (log_) log_->states.back().observations = used.observations;
+  timing.policy = policy_->Update(used, last_state_, window_);
   PruneImu(window_.states().begin()->second.t_ns);
   for (const State& s : window_.removals().leaving_states) left_window_.push_back(EstimateOf(s));
   FrameEstimate estimate = Estimate(frame);
@@ -246,6 +249,10 @@ void Estimator::AddFirstState(const InitialState& initial, const Eigen::Matrix<d
   CHECK(llt.info() == Eigen::Success) << "the dynamic initializer's covariance is not positive definite";
   window_.AddLinearFactor({last_state_}, {}, llt.matrixU().toDenseMatrix(), Eigen::VectorXd::Zero(15));
   waiting_reason_.clear();
+  if (log_) {
+    log_->first_covariance = covariance;
+    log_->states.push_back({last_state_, initial.t_ns, {}, std::nullopt});
+  }
 }
 
 void Estimator::AddFirstState(const InitialState& initial, const StatePrior& prior) {
@@ -255,6 +262,10 @@ void Estimator::AddFirstState(const InitialState& initial, const StatePrior& pri
   s.SetSpeedBias(initial.v_w_b, initial.gyro_bias, initial.accel_bias);
   window_.AddStatePrior(last_state_, prior);
   waiting_reason_.clear();
+  if (log_) {
+    log_->first_prior = prior;
+    log_->states.push_back({last_state_, initial.t_ns, {}, std::nullopt});
+  }
 }
 
 // The state at t_ns predicted from the last one through the preintegrated
@@ -292,6 +303,7 @@ void Estimator::AddPropagatedState(Timestamp t_ns) {
   State& s = window_.AddState(last_state_, t_ns);
   s.SetPose(p.p_w_b, p.q_w_b);
   s.SetSpeedBias(p.v_w_b, b_g, b_a);
+  if (log_) log_->states.push_back({last_state_, t_ns, {}, p.preintegration});
   window_.AddImuFactor(previous, last_state_, std::move(p.preintegration));
 }
 
@@ -307,6 +319,26 @@ std::vector<FrameEstimate> Estimator::LastEstimates() const {
   for (const State& s : policy_->StatesBehindWindow(window_)) last.push_back(EstimateOf(s));
   for (const auto& [id, s] : window_.states()) last.push_back(EstimateOf(s));
   return last;
+}
+
+std::vector<FrameEstimate> Estimator::Refine(RefinementReport* report) const {
+  std::vector<FrameEstimate> refined;
+  if (!log_ || log_->states.empty()) return refined;
+  std::map<Timestamp, FrameEstimate> last;
+  for (const FrameEstimate& e : LastEstimates()) last[e.t_ns] = e;
+  const StartValue start = [&last](const LoggedState& logged, State* s) {
+    const auto it = last.find(logged.t_ns);
+    if (it == last.end()) return false;
+    s->SetPose(it->second.p_w_b, it->second.q_w_b);
+    s->SetSpeedBias(it->second.v_w_b, it->second.gyro_bias, it->second.accel_bias);
+    return true;
+  };
+  Window whole(options_.model, window_.stereo());
+  whole.SetSolveControl(window_.solve_control());
+  *report = vio::Refine(*log_, start, options_, whole);
+  if (!report->usable) return refined;
+  for (const auto& [id, s] : whole.states()) refined.push_back(EstimateOf(s));
+  return refined;
 }
 
 FrameEstimate Estimator::EstimateOfInitial(const InitialState& s) {

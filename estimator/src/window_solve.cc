@@ -14,33 +14,11 @@
 
 #include <glog/logging.h>
 
+#include "solve_control_callback.h"
 #include "vio/estimator/window.h"
 
 namespace vio {
 namespace {
-
-// The caller's SolveControl inside ceres::Solve: progress after each
-// iteration, and a stop request that ends the solve at the iterate reached.
-class SolveControlCallback final : public ceres::IterationCallback {
- public:
-  SolveControlCallback(const SolveControl& control, int max_iterations)
-      : control_(control), max_iterations_(max_iterations) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
-    if (summary.iteration == 0) initial_cost_ = summary.cost;
-    control_.Report({summary.iteration, max_iterations_, initial_cost_, summary.cost,
-                     summary.cumulative_time_in_seconds});
-    if (!control_.StopRequested()) return ceres::SOLVER_CONTINUE;
-    stopped_ = true;
-    return ceres::SOLVER_TERMINATE_SUCCESSFULLY;  // keeps the iterate reached
-  }
-  bool stopped() const { return stopped_; }
-
- private:
-  const SolveControl& control_;
-  int max_iterations_;
-  double initial_cost_ = 0;
-  bool stopped_ = false;
-};
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

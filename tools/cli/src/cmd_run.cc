@@ -18,9 +18,9 @@ DEFINE_bool(output_observations, false,
             "rectified u_L, u_R, v), for `vio matchcheck`");
 DEFINE_string(trajectory, "online",
               "which pose of each frame trajectory.txt and the evaluation hold: online (as estimated at that frame, "
-              "what a real-time user gets) or smoothed (as last estimated: when its state left the window, or at "
-              "the end: a fixed-lag smoother's output, the lag being the window; with --local_map_keyframes, the "
-              "map's keyframes at their latest estimate and every other frame moved with the keyframe before it); "
+              "what a real-time user gets) or smoothed (after the online pass, every frame refined by one global "
+              "solve of all states, landmarks and IMU factors started from each frame's last estimate: as it left "
+              "the window, or the local map's; its cost in summary.json's refinement and timing.csv's last line); "
               "batch writes its final solve either way {online|smoothed}");
 DEFINE_string(config, "", "run configuration YAML (e.g. config/euroc_stereo.yaml); flags override it");
 

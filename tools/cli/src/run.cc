@@ -313,6 +313,28 @@ void FinishEstimates(const RunRequest& request, Estimator& estimator, RunOutput&
   }
 }
 
+// --trajectory=smoothed: the offline refinement of every frame replaces the
+// last estimates; stopped by a signal, the iterate it reached (status interrupted).
+void RefineEstimates(const RunRequest& request, const Estimator& estimator, RunOutput& output, RunResult* result) {
+  const std::vector<FrameEstimate> refined = estimator.Refine(&result->refinement);
+  if (result->refinement.stopped) {
+    result->status = "interrupted";
+    result->stop_signal = StopSignalOf(request);
+    const std::string message = "interrupted by " + SignalName(result->stop_signal) + " in the refinement: " +
+                                (refined.empty() ? "the frames' last estimates are written"
+                                                 : "trajectory.txt holds the iterate it had reached");
+    LOG(WARNING) << message;
+    result->problems.push_back(message);
+  }
+  if (!refined.empty()) {
+    output.ReplaceEstimates(refined);
+    return;
+  }
+  if (!result->refinement.ran || result->refinement.stopped) return;
+  result->problems.push_back("refinement: no usable solution (the frames' last estimates are kept)");
+  result->status = "solver_failure";
+}
+
 // A run that waited more than kMaxInitWaitS or kMaxInitWaitFraction of its
 // frames before its first estimate lost that part of the trajectory: not ok.
 void CheckLateInit(RunResult* result) {
@@ -430,6 +452,8 @@ RunResult RunDataset(const RunRequest& requested) {
     throw std::runtime_error(request.dataset_dir + ": --init=groundtruth but the dataset has no ground truth");
   }
   Estimator estimator(request.config.estimator, dataset.imu_calibration, rectifier.rectified());
+  const bool refine = request.trajectory == "smoothed" && request.config.estimator.policy.policy != "batch";
+  if (refine) estimator.KeepMeasurements();
   RunOutput output(request.output_dir);
   RunResult result;
   result.trajectory = request.trajectory;
@@ -456,6 +480,10 @@ RunResult RunDataset(const RunRequest& requested) {
     solve_log.SetPhase("final solve");
     FinishEstimates(request, estimator, output, solve_log, &result);
   }
+  if (refine && result.status == "ok") {
+    solve_log.SetPhase("refinement");
+    RefineEstimates(request, estimator, output, &result);
+  }
   if (result.status == "interrupted") {
     progress.Stop();
   } else {
@@ -468,7 +496,7 @@ RunResult RunDataset(const RunRequest& requested) {
   result.real_time_factor = result.processing_s > 0 ? result.dataset_duration_s / result.processing_s : 0.0;
   Evaluate(dataset, request, output, &result);
   output.WriteTrajectory();
-  output.WriteTiming();
+  output.WriteTiming(result.refinement);
   result.peak_memory_mb = PeakMemoryMb();
   output.WriteSummary(result, source->ReportJson(), request, result.peak_memory_mb, estimator.waiting_reason());
   output.WriteConfig(RunConfigToYaml(request.config));

@@ -46,6 +46,15 @@ std::string StageTimesJson(const std::vector<FrameEstimate>& f) {
   return os.str();
 }
 
+std::string RefinementJson(const RefinementReport& r) {
+  std::ostringstream out;
+  out << "{\"seconds\": " << JsonNumber(r.seconds) << ", \"iterations\": " << r.iterations
+      << ", \"states\": " << r.states << ", \"landmarks\": " << r.landmarks
+      << ", \"initial_cost\": " << JsonNumber(r.initial_cost) << ", \"final_cost\": " << JsonNumber(r.final_cost)
+      << ", \"usable\": " << (r.usable ? "true" : "false") << "}";
+  return out.str();
+}
+
 std::string HealthJson(const RunHealth& h) {
   std::ostringstream os;
   os << "{\"frames_waiting_init\": " << h.frames_waiting_init << ", \"frames_before_imu\": " << h.frames_before_imu << ", \"frames_after_imu\": " << h.frames_after_imu
@@ -111,7 +120,7 @@ void RunOutput::WriteTrajectory() {
   RenameOver(path + ".tmp", path);
 }
 
-void RunOutput::WriteTiming() const {
+void RunOutput::WriteTiming(const RefinementReport& refinement) const {
   std::ofstream out = OpenForWriting(dir_ + "/timing.csv");
   out << "#timestamp [ns],propagate [ms],build [ms],solve [ms],marginalize [ms],total [ms],"
          "solver_iterations,states,landmarks,observations,residual blocks\n";
@@ -121,6 +130,10 @@ void RunOutput::WriteTiming() const {
         << JsonNumber(p.solve_ms) << "," << JsonNumber(p.marginalize_ms) << "," << JsonNumber(f.timing.total_ms) << ","
         << p.solver_iterations << "," << f.num_states << "," << f.num_landmarks << "," << f.num_observations
         << "," << f.num_residuals << "\n";
+  }
+  if (refinement.ran) {
+    out << "# refinement [ms],solver_iterations,states,landmarks: " << JsonNumber(1e3 * refinement.seconds) << ","
+        << refinement.iterations << "," << refinement.states << "," << refinement.landmarks << "\n";
   }
 }
 
@@ -155,6 +168,7 @@ void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_jso
     out << ",\n  \"evaluation\": " << evaluation;
   }
   if (r.nees) out << ",\n  \"nees\": " << NeesJson(*r.nees);
+  if (r.refinement.ran) out << ",\n  \"refinement\": " << RefinementJson(r.refinement);
   out << "\n}\n";
   out.close();
   if (!out) throw std::runtime_error(dir_ + "/summary.json.tmp: cannot write");

@@ -28,7 +28,8 @@ class RunOutput {
 
   /// Replaces trajectory.txt by every frame's pose as it is now (atomically).
   void WriteTrajectory();
-  void WriteTiming() const;
+  /// timing.csv; a refinement that ran adds a last comment line with its cost.
+  void WriteTiming(const RefinementReport& refinement) const;
   void WriteSummary(const RunResult& result, const std::string& frontend_json, const RunRequest& request,
                     double peak_memory_mb, const std::string& waiting_reason) const;
   void WriteConfig(const std::string& yaml) const;

@@ -4,8 +4,10 @@
 // the same variable. While the data streams in, the recent states are solved
 // every few frames with the states older than the window (and landmarks only
 // they see) held constant; after the last frame everything is freed and
-// solved together (sparse Schur): the offline reference and the accuracy
-// floor of the online policies.
+// solved together (SolveWhole: sparse Cholesky of the whole system, segments
+// of states with the landmarks only they see eliminated first, on a copy laid
+// out by id): the offline reference and the accuracy floor of the online
+// policies.
 #include <set>
 
 #include "vio/estimator/policy.h"
@@ -14,8 +16,8 @@ namespace vio {
 
 class BatchPolicy final : public Policy {
  public:
-  /// Always Ceres' Levenberg-Marquardt (step=lm): the whole sequence is one
-  /// sparse problem, beyond the window's dense Gauss-Newton.
+  /// Always Ceres' Levenberg-Marquardt (Window::SolveSparse): the whole
+  /// sequence is one sparse problem, beyond the window's dense Gauss-Newton.
   explicit BatchPolicy(const EstimatorOptions& options) : options_(options) { options_.solver.step = "lm"; }
   PolicyTiming Update(const StereoFrame& frame, StateId new_state, Window& window) override;
   bool Finish(Window& window) override;

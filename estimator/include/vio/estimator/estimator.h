@@ -14,6 +14,7 @@
 #include "vio/estimator/estimator_options.h"
 #include "vio/estimator/initializer.h"
 #include "vio/estimator/policy.h"
+#include "vio/estimator/refinement.h"
 #include "vio/estimator/rig_checks.h"
 #include "vio/estimator/tracking_monitor.h"
 #include "vio/estimator/window.h"
@@ -66,6 +67,12 @@ class Estimator {
   /// other frames moved with them (LocalMap::LastStates). ProcessFrame's
   /// per-frame estimates are the filter's.
   std::vector<FrameEstimate> LastEstimates() const;
+  /// Keeps every frame's measurements (observations after gating, IMU factors, the first prior) from
+  /// now on, for Refine: call before the first frame.
+  void KeepMeasurements() { log_.emplace(); }
+  /// The offline refinement (refinement.h): every kept state, landmark and IMU factor solved together,
+  /// started from LastEstimates(). Nothing when no measurements were kept or the solve was unusable.
+  std::vector<FrameEstimate> Refine(RefinementReport* report) const;
 
   /// The body pose at t_ns predicted by the IMU from the newest state (for a
   /// front end's outlier rejection); nothing before initialization or when
@@ -156,6 +163,7 @@ class Estimator {
   std::deque<RotationCheckFrame> rotation_frames_;  ///< the last RotationCheck::kPairSpanS, until it decided
   int implausible_inits_ = 0;                   ///< dynamic initializations in a row that were implausible
   std::string input_problem_;
+  std::optional<MeasurementLog> log_;  ///< with KeepMeasurements: every state's measurements
 };
 
 }  // namespace vio

@@ -13,6 +13,8 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <string>
+#include <unordered_map>
 #include <vector>
 
 #include <ceres/ceres.h>
@@ -129,6 +131,12 @@ class Window {
   /// The caller's stop request and progress hook, used by every Solve and TakeSteps from now on.
   void SetSolveControl(SolveControl control) { solve_control_ = std::move(control); }
   const SolveControl& solve_control() const { return solve_control_; }
+  /// Levenberg-Marquardt over the variable blocks (the constant ones held) on a copy of their cost laid
+  /// out by id. options.linear_solver: dense, sparse, iterative: the landmarks not tied by a prior
+  /// eliminated first (DENSE_SCHUR, SPARSE_SCHUR, ITERATIVE_SCHUR); sparse_full: the whole system by
+  /// sparse Cholesky, segments of states and the landmarks only they see first (EliminationGroups).
+  /// Depends only on the values, not on the heap layout (batch's solves; window_sparse_solve.cc).
+  SolveReport SolveSparse(const SolverOptions& options);
   /// Re-preintegrates IMU factors whose gyro-bias linearization moved too far.
   int RefreshImuFactors(double gyro_bias_threshold);
   /// J^T J of the whole cost at the current values over the tangent spaces of the states'
@@ -221,6 +229,10 @@ class Window {
   std::vector<double*> Blocks(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks);
   SolveReport GaussNewton(int max_steps, bool until_converged, const SolverOptions& options);
   SolveReport LevenbergMarquardt(const ceres::Solver::Options& base, const SolverOptions& options);
+  struct IdOrderedCopy;
+  std::unordered_map<const double*, int> EliminationGroups(const std::string& linear_solver) const;
+  SolveReport SolveCopy(const SolverOptions& options, const std::vector<ceres::ResidualBlockId>& residuals,
+                        const IdOrderedCopy& ids);
   std::set<const double*> BlocksInPriors() const;
   /// Every residual block: priors in creation order, IMU factors and
   /// observations by ids (never by address).

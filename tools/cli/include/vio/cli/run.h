@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "vio/cli/run_config.h"
+#include "vio/estimator/refinement.h"
 #include "vio/estimator/tracking_monitor.h"
 #include "vio/evaluation/nees.h"
 #include "vio/evaluation/trajectory_eval.h"
@@ -34,7 +35,7 @@ struct RunRequest {
   bool output_covariance = false;  ///< write covariance.csv (one more linearization per frame)
   bool output_observations = false;  ///< write observations.csv (inside the timed loop: a little slower)
   /// trajectory.txt and the evaluation: "online" (each frame's pose as estimated at that frame) or
-  /// "smoothed" (as last estimated: when its state left the window, or at the end; Estimator::LastEstimates).
+  /// "smoothed" (every frame refined after the online pass, from Estimator::LastEstimates: Estimator::Refine).
   /// batch writes its final solve either way.
   std::string trajectory = "online";
   /// Asked between frames and between solver iterations: a signal number (SIGINT, SIGTERM) ends
@@ -102,6 +103,7 @@ struct RunResult {
   InitReport init;
   std::optional<TrajectoryEvaluation> evaluation;  ///< when ground truth exists
   std::optional<NeesResult> nees;  ///< with output_covariance, when ground truth exists (same alignment)
+  RefinementReport refinement;     ///< trajectory=smoothed: the offline refinement's cost (in processing_s)
 };
 
 /// Runs and writes the output folder. Throws DatasetError / ConfigError /

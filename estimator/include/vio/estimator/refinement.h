@@ -1,0 +1,61 @@
+#pragma once
+// The offline refinement (--trajectory=smoothed): after the online pass, one
+// global solve of every frame — all states, every landmark, every IMU factor
+// and the first state's prior — started from each state's last online
+// estimate (as it left the window, or the local map's), so that it converges
+// in a few iterations. Batch's final solve is the same solve
+// (SolveWhole). The estimator logs what the policy was given per frame
+// (MeasurementLog): the observations and the IMU factor, not images.
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "vio/estimator/estimator_options.h"
+#include "vio/estimator/window.h"
+
+namespace vio {
+
+/// One state's measurements, as the policy received them.
+struct LoggedState {
+  StateId id;
+  Timestamp t_ns = 0;
+  std::vector<StereoObservation> observations;  ///< after gating; empty when tracking was lost
+  std::optional<ImuPreintegration> imu;          ///< from the previous logged state (none for the first)
+};
+
+/// Every state's measurements and the first state's prior (one of the two forms).
+struct MeasurementLog {
+  std::optional<StatePrior> first_prior;
+  std::optional<Eigen::Matrix<double, 15, 15>> first_covariance;  ///< dynamic initialization
+  std::vector<LoggedState> states;  ///< in time order
+};
+
+/// The cost of one refinement (summary.json, timing.csv).
+struct RefinementReport {
+  bool ran = false;
+  double seconds = 0;  ///< building and solving [s]
+  int iterations = 0;
+  int states = 0;
+  int landmarks = 0;
+  double initial_cost = 0;
+  double final_cost = 0;
+  bool usable = false;
+  bool stopped = false;  ///< the solve control asked to stop: the iterate reached (usable when finite)
+};
+
+/// The final solve over every state and landmark of `window` (batch's, and the refinement's):
+/// Levenberg-Marquardt on an id-ordered copy, the whole system by sparse Cholesky with each segment of
+/// states and the landmarks only it sees eliminated first (Window::SolveSparse, sparse_full),
+/// at most batch.batch_final_iterations iterations, function_tolerance 1e-6, no time bound.
+SolveReport SolveWhole(Window& window, const EstimatorOptions& options);
+
+/// The start value of a logged state (its pose and speed/bias set on `state`); false: none (the
+/// state is then predicted by the IMU from the previous one).
+using StartValue = std::function<bool(const LoggedState& logged, State* state)>;
+
+/// Builds the whole problem of `log` in `whole` (an empty window), each state at its start value and
+/// each landmark stereo-triangulated from the first state that sees it, and solves it (SolveWhole).
+RefinementReport Refine(const MeasurementLog& log, const StartValue& start, const EstimatorOptions& options,
+                        Window& whole);
+
+}  // namespace vio

@@ -1,0 +1,188 @@
+// Window::SolveSparse: Levenberg-Marquardt over the window's variable blocks
+// on a copy of their cost laid out by id, landmarks eliminated first (Schur
+// complement), the reduced state system solved sparsely. Ceres orders the
+// blocks of one elimination group by address; in the copy every block lives
+// in one buffer filled in id order, so that order is the id order and the
+// solve depends only on the values (batch's solves; bundle adjustment).
+#include <cstring>
+#include <map>
+#include <set>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <glog/logging.h>
+
+#include "solve_control_callback.h"
+#include "vio/estimator/window.h"
+
+namespace vio {
+namespace {
+
+ceres::LinearSolverType SchurSolverFor(const std::string& linear_solver) {
+  if (linear_solver == "dense") return ceres::DENSE_SCHUR;
+  if (linear_solver == "iterative") return ceres::ITERATIVE_SCHUR;
+  return ceres::SPARSE_SCHUR;
+}
+
+ceres::LinearSolverType NormalSolverFor(const std::string& linear_solver) {
+  if (linear_solver == "dense") return ceres::DENSE_NORMAL_CHOLESKY;
+  if (linear_solver == "iterative") return ceres::CGNR;
+  return ceres::SPARSE_NORMAL_CHOLESKY;
+}
+
+// Ceres' options for `options`, the Schur solvers when `ordering` has something to eliminate.
+ceres::Solver::Options LinearSolverOptions(const SolverOptions& options,
+                                           const std::shared_ptr<ceres::ParameterBlockOrdering>& ordering) {
+  ceres::Solver::Options solver;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = options.function_tolerance;
+  if (options.max_solver_time_s > 0) solver.max_solver_time_in_seconds = options.max_solver_time_s;
+  solver.num_threads = options.num_threads;
+  solver.logging_type = ceres::SILENT;
+  if (options.linear_solver == "sparse_full") {  // the whole system, segments' interiors first
+    solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    solver.linear_solver_ordering = ordering;
+    return solver;
+  }
+  const bool eliminable = ordering->GroupSize(0) > 0;
+  solver.linear_solver_type =
+      eliminable ? SchurSolverFor(options.linear_solver) : NormalSolverFor(options.linear_solver);
+  if (eliminable) solver.linear_solver_ordering = ordering;
+  if (options.linear_solver == "iterative") {
+    solver.preconditioner_type = eliminable ? ceres::SCHUR_JACOBI : ceres::JACOBI;
+  }
+  return solver;
+}
+
+}  // namespace
+
+// The window's blocks a set of residuals touches, copied into one buffer in
+// id order; `copy_of` maps a window block to its copy (a lookup only: the
+// order is `blocks`').
+struct Window::IdOrderedCopy {
+  std::vector<double> values;
+  std::vector<const double*> blocks;  ///< window blocks, in copy order
+  std::unordered_map<const double*, double*> copy_of;
+};
+
+SolveReport Window::SolveSparse(const SolverOptions& options) {
+  const auto variable = [this](const double* block) { return !problem_->IsParameterBlockConstant(block); };
+  std::vector<StateId> state_ids;
+  std::vector<LandmarkId> landmark_ids;
+  for (const auto& [id, s] : states_) {
+    if (variable(s.pose) || variable(s.speed_bias)) state_ids.push_back(id);
+  }
+  for (const auto& [id, landmark] : landmarks_) {
+    if (variable(landmark.p_w)) landmark_ids.push_back(id);
+  }
+  if (state_ids.empty() && landmark_ids.empty()) return SolveReport();
+  const std::vector<ceres::ResidualBlockId> residuals = ResidualOrderOf(LeavingOf(state_ids, landmark_ids));
+
+  // Every block the residuals touch, states (pose, speed/bias) then landmarks, by id.
+  std::unordered_map<const double*, int> touched;
+  for (ceres::ResidualBlockId residual : residuals) {
+    std::vector<double*> blocks;
+    problem_->GetParameterBlocksForResidualBlock(residual, &blocks);
+    for (const double* block : blocks) touched.emplace(block, 0);
+  }
+  IdOrderedCopy copy;
+  std::vector<size_t> offsets;
+  const auto take = [&](const double* block) {
+    if (!touched.count(block)) return;
+    copy.blocks.push_back(block);
+    offsets.push_back(copy.values.size());
+    copy.values.insert(copy.values.end(), block, block + problem_->ParameterBlockSize(block));
+  };
+  for (const auto& [id, s] : states_) {
+    take(s.pose);
+    take(s.speed_bias);
+  }
+  for (const auto& [id, landmark] : landmarks_) take(landmark.p_w);
+  CHECK_EQ(copy.blocks.size(), touched.size()) << "a residual touches a block that is no state or landmark";
+  for (size_t k = 0; k < copy.blocks.size(); ++k) copy.copy_of[copy.blocks[k]] = copy.values.data() + offsets[k];
+  return SolveCopy(options, residuals, copy);
+}
+
+// The elimination group (0 first) of every state and landmark block.
+// Schur solvers: the landmarks not tied by a prior (an independent set), then
+// the rest. sparse_full: the states cut into segments of kSegmentStates by id;
+// group 0 holds every state but each segment's last and the landmarks seen
+// from one segment only, group 1 the segments' last states and the landmarks
+// seen from several (a whole sequence re-observes landmarks across it). Each
+// segment's interior is eliminated on its own, with fill only among its states
+// and landmarks and its two end states; the separator, group 1, is one small
+// dense system. Landmarks first would leave a nearly dense system over every
+// pose; states first (the IMU chain) a dense block of every state against
+// every landmark.
+std::unordered_map<const double*, int> Window::EliminationGroups(const std::string& linear_solver) const {
+  constexpr int kSegmentStates = 20;
+  const std::set<const double*> in_prior = BlocksInPriors();
+  std::unordered_map<const double*, int> group;
+  std::map<StateId, int> segment;
+  int k = 0;
+  for (const auto& [id, s] : states_) {
+    const bool separator = linear_solver != "sparse_full" || k % kSegmentStates == kSegmentStates - 1;
+    segment[id] = k++ / kSegmentStates;
+    group[s.pose] = group[s.speed_bias] = separator ? 1 : 0;
+  }
+  for (const auto& [id, landmark] : landmarks_) {
+    const bool one_segment = linear_solver != "sparse_full" || landmark.observed_from.empty() ||
+                             segment.at(*landmark.observed_from.begin()) == segment.at(*landmark.observed_from.rbegin());
+    const bool eliminable = landmark.anchored_to.empty() && !in_prior.count(landmark.p_w);
+    group[landmark.p_w] = one_segment && eliminable ? 0 : 1;
+  }
+  return group;
+}
+
+// LM on the copy.
+SolveReport Window::SolveCopy(const SolverOptions& options, const std::vector<ceres::ResidualBlockId>& residuals,
+                              const IdOrderedCopy& ids) {
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem copy(problem_options);
+  const std::unordered_map<const double*, int> groups = EliminationGroups(options.linear_solver);
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (const double* block : ids.blocks) {
+    double* c = ids.copy_of.at(block);
+    copy.AddParameterBlock(c, problem_->ParameterBlockSize(block),
+                           const_cast<ceres::Manifold*>(problem_->GetManifold(block)));
+    const bool constant = problem_->IsParameterBlockConstant(block);
+    if (constant) copy.SetParameterBlockConstant(c);
+    ordering->AddElementToGroup(c, constant ? 1 : groups.at(block));
+  }
+  for (ceres::ResidualBlockId residual : residuals) {
+    std::vector<double*> window_blocks;
+    problem_->GetParameterBlocksForResidualBlock(residual, &window_blocks);
+    for (double*& block : window_blocks) block = ids.copy_of.at(block);
+    copy.AddResidualBlock(const_cast<ceres::CostFunction*>(problem_->GetCostFunctionForResidualBlock(residual)),
+                          const_cast<ceres::LossFunction*>(problem_->GetLossFunctionForResidualBlock(residual)),
+                          window_blocks);
+  }
+  ceres::Solver::Options solver = LinearSolverOptions(options, ordering);
+  SolveControlCallback control(solve_control_, solver.max_num_iterations);
+  solver.callbacks.push_back(&control);
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &copy, &summary);
+  SolveReport report;
+  report.iterations = static_cast<int>(summary.iterations.size());
+  report.initial_cost = summary.initial_cost;
+  report.final_cost = summary.final_cost;
+  report.usable = summary.IsSolutionUsable();
+  report.converged = summary.termination_type == ceres::CONVERGENCE;
+  report.stopped = control.stopped();
+  if (report.stopped) ++health_.stopped_solves;
+  if (!report.usable) {
+    ++health_.failed_solves;
+    return report;
+  }
+  for (const double* block : ids.blocks) {
+    if (problem_->IsParameterBlockConstant(block)) continue;
+    std::memcpy(const_cast<double*>(block), ids.copy_of.at(block), sizeof(double) * problem_->ParameterBlockSize(block));
+  }
+  return report;
+}
+
+}  // namespace vio
