@@ -73,6 +73,14 @@ DEFINE_string(drop_pattern, "even",
               "where dropped frames go: even (gaps of exactly --drop_gap_frames, evenly spread) or burst (bursts of "
               "1 to --drop_gap_frames frames, more where the camera rotates fast, as real recordings drop them; e.g. "
               "--drop_frames=0.2 --drop_gap_frames=3 --drop_pattern=burst) {even|burst}");
+DEFINE_double(time_offset_ms, 0.0, "rig error: camera stamps (cam0/cam1 data.csv, features0) written this much later "
+              "than the IMU time the images were taken at; an image stamped t was taken at IMU time t - offset [ms]");
+DEFINE_double(extrinsic_error_deg, 0.0, "rig error: both cameras' T_BS in sensor.yaml rotated by this in the body "
+              "(the cameras are simulated with the true rig; the baseline is kept) [deg]");
+DEFINE_double(extrinsic_error_m, 0.0, "rig error: both cameras' T_BS in sensor.yaml moved by this in the body [m]");
+DEFINE_string(extrinsic_error_axis, "", "rig error: the rotation axis x,y,z in the body (empty: drawn from --seed)");
+DEFINE_string(extrinsic_error_direction, "",
+              "rig error: the translation direction x,y,z in the body (empty: drawn from --seed)");
 DEFINE_string(blackouts, "", "spans with nothing to track, START:DURATION[,...] in s after the first frame: "
               "no features, black images");
 
@@ -153,6 +161,15 @@ SimulatorOptions OptionsFromFlags() {
   options.gaps.gap_frames = FLAGS_drop_gap_frames;
   options.gaps.pattern = ParseDropPattern("drop_pattern", FLAGS_drop_pattern);
   options.gaps.blackouts = ParseBlackouts("blackouts", FLAGS_blackouts);
+  options.rig.time_offset_ms = FLAGS_time_offset_ms;
+  options.rig.extrinsic_error_deg = FLAGS_extrinsic_error_deg;
+  options.rig.extrinsic_error_m = FLAGS_extrinsic_error_m;
+  if (!FLAGS_extrinsic_error_axis.empty()) {
+    options.rig.rotation_axis = ParseVector3("extrinsic_error_axis", FLAGS_extrinsic_error_axis);
+  }
+  if (!FLAGS_extrinsic_error_direction.empty()) {
+    options.rig.translation_direction = ParseVector3("extrinsic_error_direction", FLAGS_extrinsic_error_direction);
+  }
   return options;
 }
 

@@ -49,6 +49,7 @@ void CheckOptions(const SimulatorOptions& options) {
   }
   CheckSensorOptions(options.sensor);
   CheckImageTextureOptions(options.textures);
+  CheckRigErrorOptions(options.rig);
   if (options.png_compression < 0 || options.png_compression > 9) {
     throw std::invalid_argument("simulator: PNG compression must be in 0..9, got " +
                                 std::to_string(options.png_compression));
@@ -326,7 +327,13 @@ Simulation BuildSimulation(const SimulatorOptions& options) {
 void WriteSimulation(const Simulation& simulation, const SimulatorOptions& options,
                      const RenderProgress& progress) {
   if (options.output_dir.empty()) throw std::invalid_argument("simulator: an output folder is required");
-  WriteEuroc(simulation.dataset, options.output_dir);
+  if (options.rig.any()) {
+    EurocDataset written = simulation.dataset;
+    ApplyRigErrors(options.rig, options.seed, &written);
+    WriteEuroc(written, options.output_dir);
+  } else {
+    WriteEuroc(simulation.dataset, options.output_dir);
+  }
   WriteSceneCsv({simulation.scene.room, simulation.scene.boxes}, options.output_dir + "/mav0/scene.csv");
   if (options.camera_output == SimCameraOutput::kImages) WriteImages(simulation, options, progress);
 }
