@@ -21,14 +21,19 @@ Estimator::Estimator(const EstimatorOptions& options, const ImuCalibration& imu,
   imu_calibration_.accel_noise_density *= options.model.imu_noise_scale;
   imu_calibration_.gyro_random_walk *= options.model.imu_noise_scale;
   imu_calibration_.accel_random_walk *= options.model.imu_noise_scale;
-  if (options.model.estimate_time_offset) {
+  if (options.model.estimate_time_offset && options.local_map.local_map_keyframes > 0) {
+    // Parked keyframes leave the cost with their priors (Window::RemoveState): not measured with
+    // the offset in those priors, so the local map keeps the prior mean as exact.
+    LOG(WARNING) << "estimate_time_offset is not available with local_map_keyframes > 0: the time offset is "
+                    "taken as time_offset_prior_mean_ms";
+  } else if (options.model.estimate_time_offset) {
     window_.EstimateTimeOffset(1e-3 * options.model.time_offset_prior_mean_ms,
                                1e-3 * options.model.time_offset_prior_sigma_ms);
   }
 }
 
 double Estimator::time_offset_s() const {
-  return options_.model.estimate_time_offset ? window_.time_offset_s() : 1e-3 * options_.model.time_offset_prior_mean_ms;
+  return window_.estimates_time_offset() ? window_.time_offset_s() : 1e-3 * options_.model.time_offset_prior_mean_ms;
 }
 
 Timestamp Estimator::AppliedTimeOffsetNs() const { return SecondsToNanos(time_offset_s()); }
@@ -64,7 +69,10 @@ FrameEstimate Estimator::ProcessFrame(const StereoFrame& camera_frame) {
   // The frame at the IMU time it was taken (the offset's current estimate), after the last state.
   StereoFrame frame = camera_frame;
   frame.t_ns = ImuTimeOf(camera_frame.t_ns);
-  if (last_state_.valid() && window_.estimates_time_offset()) frame.t_ns = std::max(frame.t_ns, window_.state(last_state_).t_ns + 1'000'000);
+  if (window_.estimates_time_offset()) {  // within the IMU given so far, after the last state
+    if (!imu_.empty()) frame.t_ns = std::min(frame.t_ns, imu_.back().t_ns);
+    if (last_state_.valid()) frame.t_ns = std::max(frame.t_ns, window_.state(last_state_).t_ns + 1'000'000);
+  }
   const double applied_offset_s = NanosToSeconds(camera_frame.t_ns - frame.t_ns);
   if (!last_state_.valid()) {
     if (!Initialize(frame)) {

@@ -181,7 +181,7 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
   for (size_t k = 0; k < source.size(); ++k) {
     const Timestamp t_ns = source.time(k);
     if (dataset.imu.empty() || t_ns < dataset.imu.front().t_ns) continue;  // counted by ReportFramesOutsideImu
-    if (t_ns > dataset.imu.back().t_ns || estimator.ImuTimeOf(t_ns) > dataset.imu.back().t_ns) break;
+    if (t_ns > dataset.imu.back().t_ns) break;
     if (first_covered_ns < 0) first_covered_ns = t_ns;
     try {
       if (auto gap = imu.FeedUpTo(estimator.ImuTimeOf(t_ns), result->frames_estimated > 0, &estimator)) {
@@ -372,7 +372,7 @@ RunResult RunDataset(const RunRequest& requested) {
   EstimateFrames(request, dataset, *source, estimator, output, observations ? &*observations : nullptr, &result);
   if (observations) observations->Close();
   result.tracking = estimator.tracking();
-  result.calibration.time_offset_estimated = request.config.estimator.model.estimate_time_offset;
+  result.calibration.time_offset_estimated = estimator.window().estimates_time_offset();
   result.calibration.time_offset_ms = 1e3 * estimator.time_offset_s();
   if (const std::optional<double> sigma = estimator.TimeOffsetSigma()) result.calibration.time_offset_sigma_ms = 1e3 * *sigma;
   // Every frame's state as last estimated, whether the run finished or stopped.
