@@ -10,6 +10,7 @@
 
 #include "vio/estimator/dynamic_initializer.h"
 #include "vio/estimator/so3.h"
+#include "vio/estimator/stereo_geometry.h"
 #include "vio/estimator/stereo_motion.h"
 
 namespace vio {
@@ -32,6 +33,38 @@ Estimator::Estimator(const EstimatorOptions& options, const ImuCalibration& imu,
   imu_calibration_.accel_noise_density *= options.model.imu_noise_scale;
   imu_calibration_.gyro_random_walk *= options.model.imu_noise_scale;
   imu_calibration_.accel_random_walk *= options.model.imu_noise_scale;
+  if (options.model.estimate_time_offset && options.local_map.local_map_keyframes > 0) {
+    // Parked keyframes leave the cost with their priors (Window::RemoveState): not measured with
+    // the offset in those priors, so the local map keeps the prior mean as exact.
+    LOG(WARNING) << "estimate_time_offset is not available with local_map_keyframes > 0: the time offset is "
+                    "taken as time_offset_prior_mean_ms";
+  } else if (options.model.estimate_time_offset) {
+    window_.EstimateTimeOffset(1e-3 * options.model.time_offset_prior_mean_ms,
+                               1e-3 * options.model.time_offset_prior_sigma_ms);
+  }
+}
+
+double Estimator::time_offset_s() const {
+  return window_.estimates_time_offset() ? window_.time_offset_s() : 1e-3 * options_.model.time_offset_prior_mean_ms;
+}
+
+Timestamp Estimator::AppliedTimeOffsetNs() const { return SecondsToNanos(time_offset_s()); }
+
+std::map<LandmarkId, Eigen::Vector3d> Estimator::ImageVelocities(const StereoFrame& frame) const {
+  std::map<LandmarkId, Eigen::Vector3d> velocity;
+  const State& s = window_.state(last_state_);
+  // The bias-corrected gyro at the frame: the IMU sample nearest its time.
+  const auto after = std::lower_bound(imu_.begin(), imu_.end(), s.t_ns,
+                                      [](const ImuSample& m, Timestamp t) { return m.t_ns < t; });
+  if (imu_.empty()) return velocity;
+  auto nearest = after == imu_.end() ? std::prev(after) : after;
+  if (nearest != imu_.begin() && s.t_ns - std::prev(nearest)->t_ns < nearest->t_ns - s.t_ns) nearest = std::prev(nearest);
+  const Eigen::Vector3d omega_b = nearest->gyro_rad_s - s.gyro_bias();
+  for (const StereoObservation& obs : frame.observations) {
+    velocity.emplace(obs.landmark, ImageVelocity(obs.z_px, window_.stereo(), s.q_w_b(), s.v_w_b(), omega_b,
+                                                 options_.model.min_disparity_px, options_.model.max_depth_m));
+  }
+  return velocity;
 }
 
 void Estimator::AddImu(const ImuSample& sample) {
@@ -41,11 +74,19 @@ void Estimator::AddImu(const ImuSample& sample) {
 
 void Estimator::SetInitialState(const InitialState& state) { given_initial_state_ = state; }
 
-FrameEstimate Estimator::ProcessFrame(const StereoFrame& frame) {
+FrameEstimate Estimator::ProcessFrame(const StereoFrame& camera_frame) {
   const auto start = std::chrono::steady_clock::now();
   window_.ClearRemovals();
   CheckRotation(frame);
   FrameTiming timing;
+  // The frame at the IMU time it was taken (the offset's current estimate), after the last state.
+  StereoFrame frame = camera_frame;
+  frame.t_ns = ImuTimeOf(camera_frame.t_ns);
+  if (window_.estimates_time_offset()) {  // within the IMU given so far, after the last state
+    if (!imu_.empty()) frame.t_ns = std::min(frame.t_ns, imu_.back().t_ns);
+    if (last_state_.valid()) frame.t_ns = std::max(frame.t_ns, window_.state(last_state_).t_ns + 1'000'000);
+  }
+  const double applied_offset_s = NanosToSeconds(camera_frame.t_ns - frame.t_ns);
   if (!last_state_.valid()) {
     if (!Initialize(frame)) {
       FrameEstimate waiting;
@@ -55,6 +96,7 @@ FrameEstimate Estimator::ProcessFrame(const StereoFrame& frame) {
   } else {
     AddPropagatedState(frame.t_ns);
   }
+  if (window_.estimates_time_offset()) window_.SetCameraTiming(last_state_, applied_offset_s, ImageVelocities(frame));
   timing.propagate_ms = MillisecondsSince(start);
   const bool tracked = tracking_.Observe(frame.t_ns, static_cast<int>(frame.observations.size()));
   const StereoFrame used = tracked ? GateObservations(frame) : StereoFrame{frame.t_ns, {}};

@@ -166,10 +166,18 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
   const ObservationKey key{state_id, landmark_id};
   CHECK(observations_.count(key) == 0) << "landmark " << landmark_id.value << " observed twice in state "
                                       << state_id.value;
-  ceres::ResidualBlockId residual = problem_->AddResidualBlock(
-      WithFirstEstimates(Wrap(StereoFactor::Create(z_px, stereo_, model_.pixel_sigma)),
-                         {BlockKey::Pose(state_id), BlockKey::Landmark(landmark_id)}),
-      loss_.get(), s.pose, it->second.p_w);
+  ceres::ResidualBlockId residual = nullptr;
+  if (estimates_time_offset()) {
+    residual = problem_->AddResidualBlock(
+        WithFirstEstimates(Wrap(StereoFactorOf(state_id, landmark_id, z_px)),
+                           {BlockKey::Pose(state_id), BlockKey::Landmark(landmark_id), BlockKey::TimeOffset()}),
+        loss_.get(), s.pose, it->second.p_w, time_offset_);
+  } else {
+    residual = problem_->AddResidualBlock(
+        WithFirstEstimates(Wrap(StereoFactorOf(state_id, landmark_id, z_px)),
+                           {BlockKey::Pose(state_id), BlockKey::Landmark(landmark_id)}),
+        loss_.get(), s.pose, it->second.p_w);
+  }
   observations_[key] = Observation{z_px, residual};
   it->second.observed_from.insert(state_id);
 }
@@ -357,7 +365,10 @@ void Window::DropOutlierObservations(const std::vector<ObservationKey>& observat
   }
 }
 
-void Window::RemoveStateBookkeeping(StateId id) { states_.erase(id); }
+void Window::RemoveStateBookkeeping(StateId id) {
+  states_.erase(id);
+  camera_timing_.erase(id);
+}
 
 void Window::DropObservation(StateId state_id, LandmarkId landmark_id) {
   auto it = observations_.find({state_id, landmark_id});
@@ -414,7 +425,7 @@ void Window::DropState(StateId id) {
   removals_.leaving_states.push_back(s);
   problem_->RemoveParameterBlock(s.pose);
   problem_->RemoveParameterBlock(s.speed_bias);
-  states_.erase(id);
+  RemoveStateBookkeeping(id);
   removals_.dropped_states.push_back(id);
   ImuEdge& edge = imu_edges_.emplace(merged.to, std::move(merged)).first->second;
   AddImuResidual(edge);

@@ -29,6 +29,7 @@ BlockKey Window::KeyOf(const double* block) const {
   for (const auto& [id, landmark] : landmarks_) {
     if (block == landmark.p_w) return BlockKey::Landmark(id);
   }
+  if (block == time_offset_) return BlockKey::TimeOffset();
   LOG(FATAL) << "a parameter block that is neither a state nor a landmark of the window";
   return {};
 }

@@ -34,8 +34,9 @@ void Window::RemoveState(StateId id) {
   for (auto it = priors_.begin(); it != priors_.end();) {
     const auto of_this = [&](const double* b) { return b == s.pose || b == s.speed_bias; };
     const auto mine = std::count_if(it->blocks.begin(), it->blocks.end(), of_this);
+    const auto calibration = std::count(it->blocks.begin(), it->blocks.end(), time_offset_);
     const bool touches = mine > 0;
-    CHECK(!touches || mine == static_cast<std::ptrdiff_t>(it->blocks.size()))
+    CHECK(!touches || mine + calibration == static_cast<std::ptrdiff_t>(it->blocks.size()))
         << "state " << id.value << " shares a prior with other blocks";
     // The residual block goes with the state's parameter blocks below.
     it = touches ? priors_.erase(it) : std::next(it);
@@ -50,7 +51,7 @@ void Window::RemoveState(StateId id) {
   }
   problem_->RemoveParameterBlock(s.pose);
   problem_->RemoveParameterBlock(s.speed_bias);
-  states_.erase(id);
+  RemoveStateBookkeeping(id);
 }
 
 std::vector<std::pair<LandmarkId, Eigen::Vector3d>> Window::ObservationsOf(StateId id) const {

@@ -79,6 +79,14 @@ DEFINE_string(imu_accel_units, "m_s2", "imu0/data.csv's accelerometer written in
               "purpose: m_s2 (right) or g {m_s2|g}");
 DEFINE_bool(swap_cameras, false, "write cam0's measurements (features' camera column, images) as cam1's and back, "
             "the calibration unchanged: a user's mistake on purpose");
+DEFINE_double(time_offset_ms, 0.0, "rig error: camera stamps (cam0/cam1 data.csv, features0) written this much later "
+              "than the IMU time the images were taken at; an image stamped t was taken at IMU time t - offset [ms]");
+DEFINE_double(extrinsic_error_deg, 0.0, "rig error: both cameras' T_BS in sensor.yaml rotated by this in the body "
+              "(the cameras are simulated with the true rig; the baseline is kept) [deg]");
+DEFINE_double(extrinsic_error_m, 0.0, "rig error: both cameras' T_BS in sensor.yaml moved by this in the body [m]");
+DEFINE_string(extrinsic_error_axis, "", "rig error: the rotation axis x,y,z in the body (empty: drawn from --seed)");
+DEFINE_string(extrinsic_error_direction, "",
+              "rig error: the translation direction x,y,z in the body (empty: drawn from --seed)");
 DEFINE_string(blackouts, "", "spans with nothing to track, START:DURATION[,...] in s after the first frame: "
               "no features, black images");
 
@@ -162,6 +170,15 @@ SimulatorOptions OptionsFromFlags() {
   options.faults.gyro_units = FLAGS_imu_gyro_units;
   options.faults.accel_units = FLAGS_imu_accel_units;
   options.faults.swap_cameras = FLAGS_swap_cameras;
+  options.rig.time_offset_ms = FLAGS_time_offset_ms;
+  options.rig.extrinsic_error_deg = FLAGS_extrinsic_error_deg;
+  options.rig.extrinsic_error_m = FLAGS_extrinsic_error_m;
+  if (!FLAGS_extrinsic_error_axis.empty()) {
+    options.rig.rotation_axis = ParseVector3("extrinsic_error_axis", FLAGS_extrinsic_error_axis);
+  }
+  if (!FLAGS_extrinsic_error_direction.empty()) {
+    options.rig.translation_direction = ParseVector3("extrinsic_error_direction", FLAGS_extrinsic_error_direction);
+  }
   return options;
 }
 

@@ -229,7 +229,7 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
       break;
     }
     try {
-      if (auto gap = imu.FeedUpTo(t_ns, result->frames_estimated > 0, &estimator)) {
+      if (auto gap = imu.FeedUpTo(estimator.ImuTimeOf(t_ns), result->frames_estimated > 0, &estimator)) {
         StopAt(k, source.size(), "imu_gap", *gap, result);
         break;
       }
@@ -474,6 +474,10 @@ RunResult RunDataset(const RunRequest& requested) {
                  &result);
   if (observations) observations->Close();
   result.tracking = estimator.tracking();
+  result.calibration.time_offset_estimated = estimator.window().estimates_time_offset();
+  result.calibration.time_offset_calibration_ms = 1e-6 * static_cast<double>(dataset.camera_time_offset_ns);
+  result.calibration.time_offset_ms = result.calibration.time_offset_calibration_ms + 1e3 * estimator.time_offset_s();
+  if (const std::optional<double> sigma = estimator.TimeOffsetSigma()) result.calibration.time_offset_sigma_ms = 1e3 * *sigma;
   // Every frame's state as last estimated, whether the run finished or stopped.
   if (request.trajectory == "smoothed") output.ReplaceEstimates(estimator.LastEstimates());
   if (result.status == "ok") {

@@ -159,6 +159,11 @@ void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_jso
   if (!waiting_reason.empty()) out << ",\n  \"not_initialized_reason\": " << JsonString(waiting_reason);
   out << ",\n  \"init\": {\"method\": " << JsonString(r.init.method) << ", \"wait_s\": " << JsonNumber(r.init.wait_s)
       << ", \"wait_frames\": " << r.init.wait_frames << ", \"last_reason\": " << JsonString(r.init.last_reason) << "}";
+  out << ",\n  \"calibration\": {\"time_offset_estimated\": " << (r.calibration.time_offset_estimated ? "true" : "false")
+      << ", \"time_offset_ms\": " << JsonNumber(r.calibration.time_offset_ms)
+      << ", \"time_offset_calibration_ms\": " << JsonNumber(r.calibration.time_offset_calibration_ms);
+  if (r.calibration.time_offset_sigma_ms) out << ", \"time_offset_sigma_ms\": " << JsonNumber(*r.calibration.time_offset_sigma_ms);
+  out << "}";
   if (r.groundtruth_tilt_deg) out << ",\n  \"groundtruth_tilt_deg\": " << JsonNumber(*r.groundtruth_tilt_deg);
   if (r.evaluation) {
     std::string evaluation = ToJson(*r.evaluation);

@@ -50,6 +50,7 @@ void CheckOptions(const SimulatorOptions& options) {
   CheckSensorOptions(options.sensor);
   CheckImageTextureOptions(options.textures);
   CheckRigFaults(options.faults);
+  CheckRigErrorOptions(options.rig);
   if (options.png_compression < 0 || options.png_compression > 9) {
     throw std::invalid_argument("simulator: PNG compression must be in 0..9, got " +
                                 std::to_string(options.png_compression));
@@ -328,14 +329,17 @@ void WriteSimulation(const Simulation& simulation, const SimulatorOptions& optio
                      const RenderProgress& progress) {
   if (options.output_dir.empty()) throw std::invalid_argument("simulator: an output folder is required");
   WriteSceneCsv({simulation.scene.room, simulation.scene.boxes}, options.output_dir + "/mav0/scene.csv");
-  if (!options.faults.any()) {
+  if (!options.faults.any() && !options.rig.any()) {
     WriteEuroc(simulation.dataset, options.output_dir);
     if (options.camera_output == SimCameraOutput::kImages) WriteImages(simulation, options, progress);
     return;
   }
-  Simulation faulty = simulation;  // the calibration stays right, the measurements go wrong
+  // Measured with the true rig; written with the faults (measurements) and rig errors (stamps, T_BS).
+  Simulation faulty = simulation;
   ApplyRigFaults(options.faults, &faulty.dataset);
-  WriteEuroc(faulty.dataset, options.output_dir);
+  EurocDataset written = faulty.dataset;
+  ApplyRigErrors(options.rig, options.seed, &written);
+  WriteEuroc(written, options.output_dir);
   if (options.faults.swap_cameras) std::swap(faulty.dataset.cameras[0], faulty.dataset.cameras[1]);
   if (options.camera_output == SimCameraOutput::kImages) WriteImages(faulty, options, progress);
 }

@@ -4,6 +4,7 @@
 // preintegrated IMU factor) and hands the frame to the policy, which works
 // on the window.
 #include <deque>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -53,8 +54,16 @@ class Estimator {
   void AddImu(const ImuSample& sample);
   /// Starts from a known state at the first frame (--init=groundtruth).
   void SetInitialState(const InitialState& state);
-  /// Processes one stereo frame; IMU up to its time must have been added.
+  /// Processes one stereo frame; IMU up to ImuTimeOf(frame.t_ns) must have been added. The frame's
+  /// state (and its estimate's t_ns) is at that IMU time.
   FrameEstimate ProcessFrame(const StereoFrame& frame);
+  /// The IMU time of an image stamped camera_t_ns: camera_t_ns minus the camera-IMU time offset
+  /// (its current estimate, or the prior mean when it is not estimated).
+  Timestamp ImuTimeOf(Timestamp camera_t_ns) const { return camera_t_ns - AppliedTimeOffsetNs(); }
+  /// The time offset's estimate [s] (the prior mean when not estimated).
+  double time_offset_s() const;
+  /// Its marginal standard deviation at the current estimate [s]; nothing when not estimated.
+  std::optional<double> TimeOffsetSigma() { return window_.TimeOffsetSigma(); }
 
   /// Ends the run. For an offline policy (batch) this is where it solves;
   /// it then returns the final estimate of every state (which replaces the
@@ -136,6 +145,10 @@ class Estimator {
   FrameEstimate EstimateOf(const State& state) const;
   static FrameEstimate EstimateOfInitial(const InitialState& state);
   void PruneImu(Timestamp before_ns);
+  Timestamp AppliedTimeOffsetNs() const;
+  /// The frame's image velocities [px/s] by landmark at the newest state's (IMU-predicted)
+  /// velocity and bias-corrected gyro rate (ImageVelocity).
+  std::map<LandmarkId, Eigen::Vector3d> ImageVelocities(const StereoFrame& frame) const;
 
   EstimatorOptions options_;
   ImuCalibration imu_calibration_;

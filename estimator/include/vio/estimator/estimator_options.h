@@ -214,6 +214,9 @@ struct ModelOptions {
   double max_whitened_residual = 50.0;  ///< observations of window landmarks predicted worse are rejected [sigma]
   double max_imu_gap_s = 0.1;          ///< longest IMU gap the estimate bridges; a longer one ends the run [s]
   bool fej = false;  ///< first-estimate Jacobians on every block in a prior (first_estimates.h)
+  bool estimate_time_offset = true;       ///< the camera-IMU time offset is a state of the window
+  double time_offset_prior_mean_ms = 0.0;   ///< prior mean of the offset (fixed when not estimated) [ms]
+  double time_offset_prior_sigma_ms = 5.0;  ///< prior standard deviation of the offset [ms]
 
   template <class V>
   void Visit(V& v) {
@@ -236,6 +239,14 @@ struct ModelOptions {
     v("fej", fej,
       "first-estimate Jacobians: every factor's Jacobians on a block in a prior are taken at the value the block had "
       "when it entered its first prior (keeps yaw and position unobservable, as they are)");
+    v("estimate_time_offset", estimate_time_offset,
+      "estimate the camera-IMU time offset online, as a state of the window under a prior (docs/calibration.md); "
+      "false: the prior mean is taken as exact");
+    v("time_offset_prior_mean_ms", time_offset_prior_mean_ms,
+      "camera-IMU time offset's prior mean: an image stamped t was taken at IMU time t - offset [ms]",
+      Between(-1000, 1000));
+    v("time_offset_prior_sigma_ms", time_offset_prior_sigma_ms,
+      "camera-IMU time offset's prior standard deviation [ms]", Positive());
   }
 };
 

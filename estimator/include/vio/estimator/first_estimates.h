@@ -32,13 +32,14 @@ namespace vio {
 
 /// Which block of the window a factor parameter is.
 struct BlockKey {
-  enum class Kind { kPose, kSpeedBias, kLandmark };
+  enum class Kind { kPose, kSpeedBias, kLandmark, kTimeOffset };
   Kind kind = Kind::kPose;
   std::int64_t id = 0;  ///< StateId or LandmarkId value
 
   static BlockKey Pose(StateId s) { return {Kind::kPose, s.value}; }
   static BlockKey SpeedBias(StateId s) { return {Kind::kSpeedBias, s.value}; }
   static BlockKey Landmark(LandmarkId l) { return {Kind::kLandmark, l.value}; }
+  static BlockKey TimeOffset() { return {Kind::kTimeOffset, 0}; }
   bool operator<(const BlockKey& o) const { return kind != o.kind ? kind < o.kind : id < o.id; }
 };
 

@@ -12,6 +12,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <unordered_map>
@@ -103,8 +104,25 @@ class Window {
   /// Prior on one state at its current value (first state).
   void AddStatePrior(StateId id, const StatePrior& prior);
   Landmark& AddLandmark(LandmarkId id, const Eigen::Vector3d& p_w);
-  /// Stereo observation z = (u_L, u_R, v) [px] of `landmark` from `state`.
+  /// Stereo observation z = (u_L, u_R, v) [px] of `landmark` from `state`; with the time offset
+  /// estimated, a StereoTimeOffsetFactor with the image velocity SetCameraTiming gave (zero if none).
   void AddObservation(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px);
+
+  // ---- calibration: the camera-IMU time offset -------------------------------
+  /// Makes the time offset t_d [s] (an image stamped t was taken at IMU time t - t_d) a parameter
+  /// block of the window, under the prior N(mean_s, sigma_s^2), starting at the mean; every
+  /// observation added from now on depends on it (stereo_time_offset_factor.h). Once, before
+  /// the first observation.
+  void EstimateTimeOffset(double mean_s, double sigma_s);
+  bool estimates_time_offset() const { return time_offset_prior_.residual != nullptr; }
+  /// The estimate [s] (the prior mean before any observation; 0 when not estimated).
+  double time_offset_s() const { return time_offset_[0]; }
+  /// Its marginal standard deviation at the current estimate [s]; nothing when not estimated or
+  /// the information is singular.
+  std::optional<double> TimeOffsetSigma();
+  /// The offset t_a [s] the state's time was made with (its camera stamp minus t_ns) and its
+  /// observations' image velocities [px/s] by landmark: what its observations' factors use.
+  void SetCameraTiming(StateId state, double applied_offset_s, std::map<LandmarkId, Eigen::Vector3d> velocity_px_s);
   /// The landmark measured in `anchor`'s body frame (AnchoredPointFactor, no loss): the local
   /// map's summary of the observations of frames it dropped. Replaces the pair's earlier one.
   void SetAnchoredPoint(StateId anchor, LandmarkId landmark, const Eigen::Vector3d& p_b_hat,
@@ -215,6 +233,11 @@ class Window {
     std::vector<const double*> blocks;
   };
   using ObservationKey = std::pair<StateId, LandmarkId>;
+  /// A state's camera timing (SetCameraTiming).
+  struct CameraTiming {
+    double applied_offset_s = 0;
+    std::map<LandmarkId, Eigen::Vector3d> velocity_px_s;
+  };
   /// States and landmarks leaving the window (marginalized or dropped), and
   /// their parameter blocks.
   struct Leaving {
@@ -224,6 +247,9 @@ class Window {
   };
 
   void AddImuResidual(ImuEdge& edge);
+  /// The stereo factor of one observation: StereoFactor, or with the time offset estimated a
+  /// StereoTimeOffsetFactor with the state's camera timing (window_calibration.cc).
+  ceres::CostFunction* StereoFactorOf(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px) const;
   ceres::CostFunction* Wrap(ceres::CostFunction* factor) const { return wrapper_ ? wrapper_(factor) : factor; }
   /// The parameter blocks of states ([pose, speed_bias] each), then landmarks.
   std::vector<double*> Blocks(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks);
@@ -288,6 +314,9 @@ class Window {
   std::map<ObservationKey, Observation> observations_;
   std::map<ObservationKey, ceres::ResidualBlockId> anchored_points_;
   std::vector<Prior> priors_;
+  double time_offset_[1] = {0.0};  ///< [s]; a parameter block once EstimateTimeOffset was called
+  Prior time_offset_prior_;        ///< also in priors_; null residual: not estimated
+  std::map<StateId, CameraTiming> camera_timing_;
   /// Whether the last marginalization's prior had fewer rows than columns
   /// (Marginalize picks the next square root's factorization by it).
   bool last_prior_rank_deficient_ = false;

@@ -69,6 +69,14 @@ struct InitReport {
   std::string last_reason;  ///< why it was still waiting at the last frame before it started
 };
 
+/// The online calibration's estimates at the end of the run (docs/calibration.md).
+struct CalibrationReport {
+  bool time_offset_estimated = false;
+  double time_offset_ms = 0;  ///< an image stamped t was taken at IMU time t - offset [ms] (calibration's + estimate)
+  double time_offset_calibration_ms = 0;  ///< the calibration's (Kalibr's -timeshift_cam_imu), applied first [ms]
+  std::optional<double> time_offset_sigma_ms;  ///< marginal standard deviation, when estimated [ms]
+};
+
 struct RunResult {
   /// ok: every frame from initialization on estimated, every solve usable,
   /// within the sanity bounds; else the first of: imu_gap (stopped at an IMU
@@ -101,6 +109,7 @@ struct RunResult {
   double longest_frame_gap_s = 0; ///< longest frame interval [s]
   TrackingReport tracking;        ///< frames with too few observations (propagated on the IMU)
   InitReport init;
+  CalibrationReport calibration;
   std::optional<TrajectoryEvaluation> evaluation;  ///< when ground truth exists
   std::optional<NeesResult> nees;  ///< with output_covariance, when ground truth exists (same alignment)
   RefinementReport refinement;     ///< trajectory=smoothed: the offline refinement's cost (in processing_s)

@@ -30,6 +30,7 @@
 #include "vio/simulator/gaps.h"
 #include "vio/simulator/imu.h"
 #include "vio/simulator/render.h"
+#include "vio/simulator/rig_errors.h"
 #include "vio/simulator/rig_faults.h"
 #include "vio/simulator/scene.h"
 #include "vio/simulator/sensor.h"
@@ -82,6 +83,9 @@ struct SimulatorOptions {
   FeatureSimOptions features;
   /// Dropped frames and blackouts (none by default).
   FrameGapOptions gaps;
+  /// Camera-IMU time offset and extrinsic error written into the dataset (none by default;
+  /// rig_errors.h): the cameras are simulated with the true rig.
+  RigErrorOptions rig;
   /// Image rendering (images mode; texture seed derived from `seed`;
   /// the noise is the sensor's).
   RenderOptions render;
