@@ -77,7 +77,6 @@ void Estimator::SetInitialState(const InitialState& state) { given_initial_state
 FrameEstimate Estimator::ProcessFrame(const StereoFrame& camera_frame) {
   const auto start = std::chrono::steady_clock::now();
   window_.ClearRemovals();
-  CheckRotation(frame);
   FrameTiming timing;
   // The frame at the IMU time it was taken (the offset's current estimate), after the last state.
   StereoFrame frame = camera_frame;
@@ -87,6 +86,7 @@ FrameEstimate Estimator::ProcessFrame(const StereoFrame& camera_frame) {
     if (last_state_.valid()) frame.t_ns = std::max(frame.t_ns, window_.state(last_state_).t_ns + 1'000'000);
   }
   const double applied_offset_s = NanosToSeconds(camera_frame.t_ns - frame.t_ns);
+  CheckRotation(frame);
   if (!last_state_.valid()) {
     if (!Initialize(frame)) {
       FrameEstimate waiting;
@@ -96,12 +96,24 @@ FrameEstimate Estimator::ProcessFrame(const StereoFrame& camera_frame) {
   } else {
     AddPropagatedState(frame.t_ns);
   }
-  if (window_.estimates_time_offset()) window_.SetCameraTiming(last_state_, applied_offset_s, ImageVelocities(frame));
+  if (window_.estimates_time_offset()) {
+    std::map<LandmarkId, Eigen::Vector3d> velocities = ImageVelocities(frame);
+    if (log_) {
+      if (!log_->time_offset) {
+        log_->time_offset = LoggedTimeOffset{1e-3 * options_.model.time_offset_prior_mean_ms,
+                                             1e-3 * options_.model.time_offset_prior_sigma_ms, 0.0};
+      }
+      log_->states.back().applied_offset_s = applied_offset_s;
+      log_->states.back().velocity_px_s = velocities;
+    }
+    window_.SetCameraTiming(last_state_, applied_offset_s, std::move(velocities));
+  }
   timing.propagate_ms = MillisecondsSince(start);
   const bool tracked = tracking_.Observe(frame.t_ns, static_cast<int>(frame.observations.size()));
   const StereoFrame used = tracked ? GateObservations(frame) : StereoFrame{frame.t_ns, {}};
   if (log_) log_->states.back().observations = used.observations;
   timing.policy = policy_->Update(used, last_state_, window_);
+  if (log_ && log_->time_offset) log_->time_offset->estimate_s = window_.time_offset_s();
   PruneImu(window_.states().begin()->second.t_ns);
   for (const State& s : window_.removals().leaving_states) left_window_.push_back(EstimateOf(s));
   FrameEstimate estimate = Estimate(frame);

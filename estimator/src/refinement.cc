@@ -35,6 +35,10 @@ void AddFirstPrior(const MeasurementLog& log, StateId first, Window& whole) {
 
 // The states (at their start values), the first prior, the IMU factors, the landmarks and observations.
 void Build(const MeasurementLog& log, const StartValue& start, const EstimatorOptions& options, Window& whole) {
+  if (log.time_offset) {
+    whole.EstimateTimeOffset(log.time_offset->prior_mean_s, log.time_offset->prior_sigma_s);
+    whole.SetTimeOffset(log.time_offset->estimate_s);
+  }
   const State* previous = nullptr;
   for (const LoggedState& logged : log.states) {
     State& s = whole.AddState(logged.id, logged.t_ns);
@@ -46,6 +50,7 @@ void Build(const MeasurementLog& log, const StartValue& start, const EstimatorOp
     } else if (logged.imu) {
       whole.AddImuFactor(previous->id, logged.id, *logged.imu);
     }
+    if (log.time_offset) whole.SetCameraTiming(logged.id, logged.applied_offset_s, logged.velocity_px_s);
     previous = &s;
   }
   for (const LoggedState& logged : log.states) {
@@ -87,6 +92,7 @@ RefinementReport Refine(const MeasurementLog& log, const StartValue& start, cons
     report.final_cost = solve.final_cost;
     report.usable = solve.usable;
     report.stopped = solve.stopped;
+    if (whole.estimates_time_offset()) report.time_offset_s = whole.time_offset_s();
   }
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   LOG(INFO) << "refinement: " << report.states << " states, " << report.landmarks << " landmarks, "

@@ -28,6 +28,11 @@ void Window::EstimateTimeOffset(double mean_s, double sigma_s) {
   HoldFirstEstimates({time_offset_});
 }
 
+void Window::SetTimeOffset(double s) {
+  CHECK(estimates_time_offset()) << "SetTimeOffset: the time offset is not estimated";
+  time_offset_[0] = s;
+}
+
 void Window::SetCameraTiming(StateId id, double applied_offset_s, std::map<LandmarkId, Eigen::Vector3d> velocity_px_s) {
   CHECK(HasState(id)) << "camera timing of unknown state " << id.value;
   camera_timing_[id] = CameraTiming{applied_offset_s, std::move(velocity_px_s)};

@@ -77,7 +77,9 @@ SolveReport Window::SolveSparse(const SolverOptions& options) {
     if (variable(landmark.p_w)) landmark_ids.push_back(id);
   }
   if (state_ids.empty() && landmark_ids.empty()) return SolveReport();
-  const std::vector<ceres::ResidualBlockId> residuals = ResidualOrderOf(LeavingOf(state_ids, landmark_ids));
+  Leaving solved = LeavingOf(state_ids, landmark_ids);
+  if (estimates_time_offset() && variable(time_offset_)) solved.blocks.insert(time_offset_);  // and its prior
+  const std::vector<ceres::ResidualBlockId> residuals = ResidualOrderOf(solved);
 
   // Every block the residuals touch, states (pose, speed/bias) then landmarks, by id.
   std::unordered_map<const double*, int> touched;
@@ -99,7 +101,8 @@ SolveReport Window::SolveSparse(const SolverOptions& options) {
     take(s.speed_bias);
   }
   for (const auto& [id, landmark] : landmarks_) take(landmark.p_w);
-  CHECK_EQ(copy.blocks.size(), touched.size()) << "a residual touches a block that is no state or landmark";
+  take(time_offset_);  // when estimated
+  CHECK_EQ(copy.blocks.size(), touched.size()) << "a residual touches a block that is no state, landmark or calibration";
   for (size_t k = 0; k < copy.blocks.size(); ++k) copy.copy_of[copy.blocks[k]] = copy.values.data() + offsets[k];
   return SolveCopy(options, residuals, copy);
 }
@@ -132,6 +135,7 @@ std::unordered_map<const double*, int> Window::EliminationGroups(const std::stri
     const bool eliminable = landmark.anchored_to.empty() && !in_prior.count(landmark.p_w);
     group[landmark.p_w] = one_segment && eliminable ? 0 : 1;
   }
+  group[time_offset_] = 1;  // seen by every observation
   return group;
 }
 

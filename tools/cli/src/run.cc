@@ -328,6 +328,10 @@ void RefineEstimates(const RunRequest& request, const Estimator& estimator, RunO
   }
   if (!refined.empty()) {
     output.ReplaceEstimates(refined);
+    if (const std::optional<double> offset = result->refinement.time_offset_s) {  // what the trajectory was solved with
+      result->calibration.time_offset_ms = result->calibration.time_offset_calibration_ms + 1e3 * *offset;
+      result->calibration.time_offset_sigma_ms.reset();
+    }
     return;
   }
   if (!result->refinement.ran || result->refinement.stopped) return;

@@ -7,6 +7,7 @@
 // (SolveWhole). The estimator logs what the policy was given per frame
 // (MeasurementLog): the observations and the IMU factor, not images.
 #include <functional>
+#include <map>
 #include <optional>
 #include <vector>
 
@@ -21,6 +22,17 @@ struct LoggedState {
   Timestamp t_ns = 0;
   std::vector<StereoObservation> observations;  ///< after gating; empty when tracking was lost
   std::optional<ImuPreintegration> imu;          ///< from the previous logged state (none for the first)
+  /// With the time offset estimated: the offset the state's time was made with [s] and the
+  /// observations' image velocities [px/s] (Window::SetCameraTiming).
+  double applied_offset_s = 0;
+  std::map<LandmarkId, Eigen::Vector3d> velocity_px_s;
+};
+
+/// The time offset as the online window estimated it: its prior, and its estimate at the end.
+struct LoggedTimeOffset {
+  double prior_mean_s = 0;
+  double prior_sigma_s = 0;
+  double estimate_s = 0;
 };
 
 /// Every state's measurements and the first state's prior (one of the two forms).
@@ -28,6 +40,7 @@ struct MeasurementLog {
   std::optional<StatePrior> first_prior;
   std::optional<Eigen::Matrix<double, 15, 15>> first_covariance;  ///< dynamic initialization
   std::vector<LoggedState> states;  ///< in time order
+  std::optional<LoggedTimeOffset> time_offset;  ///< estimated online: estimated again, from its estimate
 };
 
 /// The cost of one refinement (summary.json, timing.csv).
@@ -40,7 +53,8 @@ struct RefinementReport {
   double initial_cost = 0;
   double final_cost = 0;
   bool usable = false;
-  bool stopped = false;  ///< the solve control asked to stop: the iterate reached (usable when finite)
+  bool stopped = false;
+  std::optional<double> time_offset_s;  ///< the refined camera-IMU time offset, when estimated [s]  ///< the solve control asked to stop: the iterate reached (usable when finite)
 };
 
 /// The final solve over every state and landmark of `window` (batch's, and the refinement's):
@@ -54,7 +68,8 @@ SolveReport SolveWhole(Window& window, const EstimatorOptions& options);
 using StartValue = std::function<bool(const LoggedState& logged, State* state)>;
 
 /// Builds the whole problem of `log` in `whole` (an empty window), each state at its start value and
-/// each landmark stereo-triangulated from the first state that sees it, and solves it (SolveWhole).
+/// each landmark stereo-triangulated from the first state that sees it, and the time offset (when
+/// logged) at its online estimate under its prior, and solves it (SolveWhole).
 RefinementReport Refine(const MeasurementLog& log, const StartValue& start, const EstimatorOptions& options,
                         Window& whole);
 

@@ -115,6 +115,8 @@ class Window {
   /// the first observation.
   void EstimateTimeOffset(double mean_s, double sigma_s);
   bool estimates_time_offset() const { return time_offset_prior_.residual != nullptr; }
+  /// Sets the estimate [s] (a start value: the offline refinement's); only when estimated.
+  void SetTimeOffset(double s);
   /// The estimate [s] (the prior mean before any observation; 0 when not estimated).
   double time_offset_s() const { return time_offset_[0]; }
   /// Its marginal standard deviation at the current estimate [s]; nothing when not estimated or
