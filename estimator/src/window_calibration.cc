@@ -33,6 +33,15 @@ void Window::SetTimeOffset(double s) {
   time_offset_[0] = s;
 }
 
+void Window::SetTimeOffsetConstant(bool constant) {
+  CHECK(estimates_time_offset()) << "SetTimeOffsetConstant: the time offset is not estimated";
+  if (constant) {
+    problem_->SetParameterBlockConstant(time_offset_);
+  } else {
+    problem_->SetParameterBlockVariable(time_offset_);
+  }
+}
+
 void Window::SetCameraTiming(StateId id, double applied_offset_s, std::map<LandmarkId, Eigen::Vector3d> velocity_px_s) {
   CHECK(HasState(id)) << "camera timing of unknown state " << id.value;
   camera_timing_[id] = CameraTiming{applied_offset_s, std::move(velocity_px_s)};

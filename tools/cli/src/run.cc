@@ -313,6 +313,14 @@ void FinishEstimates(const RunRequest& request, Estimator& estimator, RunOutput&
   }
 }
 
+// The camera-IMU time offset the run ends with (the calibration file's plus the estimate).
+void RecordTimeOffset(const EurocDataset& dataset, Estimator& estimator, CalibrationReport* calibration) {
+  calibration->time_offset_estimated = estimator.window().estimates_time_offset();
+  calibration->time_offset_calibration_ms = 1e-6 * static_cast<double>(dataset.camera_time_offset_ns);
+  calibration->time_offset_ms = calibration->time_offset_calibration_ms + 1e3 * estimator.time_offset_s();
+  if (const std::optional<double> sigma = estimator.TimeOffsetSigma()) calibration->time_offset_sigma_ms = 1e3 * *sigma;
+}
+
 // --trajectory=smoothed: the offline refinement of every frame replaces the
 // last estimates; stopped by a signal, the iterate it reached (status interrupted).
 void RefineEstimates(const RunRequest& request, const Estimator& estimator, RunOutput& output, RunResult* result) {
@@ -478,16 +486,14 @@ RunResult RunDataset(const RunRequest& requested) {
                  &result);
   if (observations) observations->Close();
   result.tracking = estimator.tracking();
-  result.calibration.time_offset_estimated = estimator.window().estimates_time_offset();
-  result.calibration.time_offset_calibration_ms = 1e-6 * static_cast<double>(dataset.camera_time_offset_ns);
-  result.calibration.time_offset_ms = result.calibration.time_offset_calibration_ms + 1e3 * estimator.time_offset_s();
-  if (const std::optional<double> sigma = estimator.TimeOffsetSigma()) result.calibration.time_offset_sigma_ms = 1e3 * *sigma;
   // Every frame's state as last estimated, whether the run finished or stopped.
   if (request.trajectory == "smoothed") output.ReplaceEstimates(estimator.LastEstimates());
   if (result.status == "ok") {
     solve_log.SetPhase("final solve");
     FinishEstimates(request, estimator, output, solve_log, &result);
   }
+  // After the final solve: batch's offset is the whole sequence's, not its online estimate's.
+  RecordTimeOffset(dataset, estimator, &result.calibration);
   if (refine && result.status == "ok") {
     solve_log.SetPhase("refinement");
     RefineEstimates(request, estimator, output, &result);

@@ -117,6 +117,8 @@ class Window {
   bool estimates_time_offset() const { return time_offset_prior_.residual != nullptr; }
   /// Sets the estimate [s] (a start value: the offline refinement's); only when estimated.
   void SetTimeOffset(double s);
+  /// Holds the estimated time offset constant in the solves (or frees it again).
+  void SetTimeOffsetConstant(bool constant);
   /// The estimate [s] (the prior mean before any observation; 0 when not estimated).
   double time_offset_s() const { return time_offset_[0]; }
   /// Its marginal standard deviation at the current estimate [s]; nothing when not estimated or
