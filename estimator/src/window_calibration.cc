@@ -49,6 +49,12 @@ void Window::SetCameraTiming(StateId id, double applied_offset_s, std::map<Landm
 
 std::optional<double> Window::TimeOffsetSigma() {
   if (!estimates_time_offset() || problem_->IsParameterBlockConstant(time_offset_)) return std::nullopt;
+  // The marginal comes from the dense reduced system over every variable state: a window's, or
+  // a short sequence's final solve, not a whole recording's (batch on EuRoC: thousands of states).
+  constexpr int kMaxStatesForSigma = 500;
+  int variable_states = 0;
+  for (const auto& [id, s] : states_) variable_states += problem_->IsParameterBlockConstant(s.pose) ? 0 : 1;
+  if (variable_states > kMaxStatesForSigma) return std::nullopt;
   const std::optional<Eigen::MatrixXd> covariance = MarginalCovariance(problem_.get(), Layout(), {time_offset_});
   if (!covariance || !((*covariance)(0, 0) > 0)) return std::nullopt;
   return std::sqrt((*covariance)(0, 0));

@@ -121,8 +121,8 @@ class Window {
   void SetTimeOffsetConstant(bool constant);
   /// The estimate [s] (the prior mean before any observation; 0 when not estimated).
   double time_offset_s() const { return time_offset_[0]; }
-  /// Its marginal standard deviation at the current estimate [s]; nothing when not estimated or
-  /// the information is singular.
+  /// Its marginal standard deviation at the current estimate [s]; nothing when not estimated, held
+  /// constant, the information is singular, or more than 500 states are variable (a dense inverse).
   std::optional<double> TimeOffsetSigma();
   /// The offset t_a [s] the state's time was made with (its camera stamp minus t_ns) and its
   /// observations' image velocities [px/s] by landmark: what its observations' factors use.
