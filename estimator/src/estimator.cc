@@ -14,13 +14,6 @@
 #include "vio/estimator/stereo_motion.h"
 
 namespace vio {
-namespace {
-
-// Implausible dynamic initializations in a row that make an input problem (one alone can be a
-// window the motion does not determine).
-constexpr int kImplausibleInits = 3;
-
-}  // namespace
 
 Estimator::Estimator(const EstimatorOptions& options, const ImuCalibration& imu, const RectifiedStereo& stereo)
     : options_(options),
@@ -41,6 +34,7 @@ Estimator::Estimator(const EstimatorOptions& options, const ImuCalibration& imu,
   } else if (options.model.estimate_time_offset) {
     window_.EstimateTimeOffset(1e-3 * options.model.time_offset_prior_mean_ms,
                                1e-3 * options.model.time_offset_prior_sigma_ms);
+    StartTimeOffsetSearch();
   }
 }
 
@@ -70,6 +64,7 @@ std::map<LandmarkId, Eigen::Vector3d> Estimator::ImageVelocities(const StereoFra
 void Estimator::AddImu(const ImuSample& sample) {
   CHECK(imu_.empty() || sample.t_ns > imu_.back().t_ns) << "IMU samples out of order at " << sample.t_ns;
   imu_.push_back(sample);
+  if (offset_search_) offset_search_->AddGyro(sample.t_ns, sample.gyro_rad_s);
 }
 
 void Estimator::SetInitialState(const InitialState& state) { given_initial_state_ = state; }
@@ -86,7 +81,7 @@ FrameEstimate Estimator::ProcessFrame(const StereoFrame& camera_frame) {
     if (last_state_.valid()) frame.t_ns = std::max(frame.t_ns, window_.state(last_state_).t_ns + 1'000'000);
   }
   const double applied_offset_s = NanosToSeconds(camera_frame.t_ns - frame.t_ns);
-  CheckRotation(frame);
+  CheckRotation(frame, camera_frame.t_ns - SecondsToNanos(1e-3 * options_.model.time_offset_prior_mean_ms));
   if (!last_state_.valid()) {
     if (!Initialize(frame)) {
       FrameEstimate waiting;
@@ -225,46 +220,6 @@ bool Estimator::TryDynamic(std::string* reason) {
   }
   init_frames_.clear();
   return true;
-}
-
-std::string Estimator::CheckDynamicResult(const DynamicInitResult& result) {
-  std::string implausible = CheckFreeGravity(result.free_gravity_norm, rig_limits_);
-  if (implausible.empty() && result.state) {
-    implausible = CheckBiases(result.state->gyro_bias, result.state->accel_bias, rig_limits_, "dynamic initialization");
-  }
-  implausible_inits_ = implausible.empty() ? 0 : implausible_inits_ + 1;
-  if (implausible_inits_ >= kImplausibleInits) input_problem_ = implausible;
-  return implausible;
-}
-
-// Each frame is paired with the oldest of the last RotationCheck::kPairSpanS (at least half of it
-// back); the gyro's rotation between them is its readings integrated as a vector (IntegratedGyro).
-void Estimator::CheckRotation(const StereoFrame& frame) {
-  if (rotation_check_.decided()) return;
-  Eigen::Vector3d gyro_sum = Eigen::Vector3d::Zero();
-  if (!rotation_frames_.empty()) {
-    const RotationCheckFrame& last = rotation_frames_.back();
-    const bool covered = !imu_.empty() && imu_.front().t_ns <= last.frame.t_ns && imu_.back().t_ns >= frame.t_ns;
-    if (covered && last.frame.t_ns < frame.t_ns) {
-      gyro_sum = last.gyro_sum + IntegratedGyro(imu_, last.frame.t_ns, frame.t_ns);
-    } else {
-      rotation_frames_.clear();
-    }
-  }
-  rotation_frames_.push_back({frame, gyro_sum});
-  const Timestamp span_ns = SecondsToNanos(RotationCheck::kPairSpanS);
-  while (rotation_frames_.front().frame.t_ns < frame.t_ns - span_ns) rotation_frames_.pop_front();
-  const RotationCheckFrame& first = rotation_frames_.front();
-  if (2 * (frame.t_ns - first.frame.t_ns) < span_ns) return;
-  const std::optional<StereoRelativePose> camera =
-      RelativeStereoPose(first.frame, frame, window_.stereo(), options_.model, options_.init.dynamic_min_landmarks);
-  if (!camera) return;
-  rotation_check_.Add(rotation_frames_.back().gyro_sum - first.gyro_sum,
-                      so3::Log(Eigen::Matrix3d(camera->T_a_b.linear())));
-  if (rotation_check_.decided()) {
-    rotation_frames_.clear();
-    if (!rotation_check_.problem().empty()) input_problem_ = rotation_check_.problem();
-  }
 }
 
 std::vector<StereoFrame> Estimator::InitFrames(Timestamp t_ns, double span_s) const {

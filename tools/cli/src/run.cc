@@ -213,7 +213,8 @@ void AddEarlierEstimates(Estimator& estimator, Timestamp first_covered_ns, Times
 // Bad data mid-run ends the loop with a status; what was estimated is kept.
 // `observations` (null: none written) receives every frame the estimator is given.
 // A stop request ends it before the next frame, or (a solve cut short) drops the frame in hand.
-void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, FrameSource& source,
+// Returns true when the time offset search found the offset beyond its prior (the pass ends there).
+bool EstimateFrames(const RunRequest& request, const EurocDataset& dataset, FrameSource& source,
                     Estimator& estimator, RunOutput& output, ObservationsCsvWriter* observations,
                     ProgressBar& progress, RunResult* result) {
   const bool init_from_gt = request.config.estimator.init.init == "groundtruth";
@@ -255,6 +256,7 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
         StopAt(k, source.size(), "bad_input", problem, result);
         break;
       }
+      if (estimator.time_offset_search() && estimator.time_offset_search()->restart) return true;
       if (!estimate.initialized) {
         ++result->health.frames_waiting_init;
         result->init.last_reason = estimator.waiting_reason();
@@ -282,6 +284,7 @@ void EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
       break;
     }
   }
+  return false;
 }
 
 // The offline policy's final estimates replace the per-frame ones. A final
@@ -314,11 +317,17 @@ void FinishEstimates(const RunRequest& request, Estimator& estimator, RunOutput&
 }
 
 // The camera-IMU time offset the run ends with (the calibration file's plus the estimate).
-void RecordTimeOffset(const EurocDataset& dataset, Estimator& estimator, CalibrationReport* calibration) {
+void RecordTimeOffset(const EurocDataset& dataset, Estimator& estimator,
+                      const std::optional<Estimator::TimeOffsetSearchReport>& search, CalibrationReport* calibration) {
   calibration->time_offset_estimated = estimator.window().estimates_time_offset();
   calibration->time_offset_calibration_ms = 1e-6 * static_cast<double>(dataset.camera_time_offset_ns);
   calibration->time_offset_ms = calibration->time_offset_calibration_ms + 1e3 * estimator.time_offset_s();
   if (const std::optional<double> sigma = estimator.TimeOffsetSigma()) calibration->time_offset_sigma_ms = 1e3 * *sigma;
+  if (search) {
+    calibration->time_offset_search_ms = calibration->time_offset_calibration_ms + 1e3 * search->offset_s;
+    calibration->time_offset_search_sigma_ms = 1e3 * search->sigma_s;
+    calibration->time_offset_search_restarted = search->restart;
+  }
 }
 
 // --trajectory=smoothed: the offline refinement of every frame replaces the
@@ -447,13 +456,11 @@ void ValidateRequest(const RunRequest& request) {
   }
 }
 
-}  // namespace
-
-RunResult RunDataset(const RunRequest& requested) {
-  ValidateRunConfig(requested.config);
-  ValidateRequest(requested);
-  WarnAboutQuestionableSettings(requested.config);
-  const EurocDataset dataset = ReadRunDataset(requested);
+// One pass over the dataset. `search`: the time offset search's result of an earlier pass that ended
+// at it (this one runs with the prior there; `earlier_pass_s` its processing time, counted in this
+// one's), else empty and filled when this pass's search asks to start again (nothing is written then).
+RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset,
+                  std::optional<Estimator::TimeOffsetSearchReport>* search, double earlier_pass_s) {
   RunRequest request = requested;
   request.config.frontend.frontend = ResolveFrontend(requested.config.frontend.frontend, dataset);
   const frontend::StereoRectifier rectifier(dataset.cameras[0], dataset.cameras[1]);
@@ -482,8 +489,13 @@ RunResult RunDataset(const RunRequest& requested) {
   const auto start = std::chrono::steady_clock::now();
   std::optional<ObservationsCsvWriter> observations;
   if (request.output_observations) observations.emplace(request.output_dir + "/observations.csv");
-  EstimateFrames(request, dataset, *source, estimator, output, observations ? &*observations : nullptr, progress,
-                 &result);
+  if (EstimateFrames(request, dataset, *source, estimator, output, observations ? &*observations : nullptr, progress,
+                     &result)) {
+    progress.Stop();
+    *search = estimator.time_offset_search();
+    result.processing_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  }
   if (observations) observations->Close();
   result.tracking = estimator.tracking();
   // Every frame's state as last estimated, whether the run finished or stopped.
@@ -493,7 +505,7 @@ RunResult RunDataset(const RunRequest& requested) {
     FinishEstimates(request, estimator, output, solve_log, &result);
   }
   // After the final solve: batch's offset is the whole sequence's, not its online estimate's.
-  RecordTimeOffset(dataset, estimator, &result.calibration);
+  RecordTimeOffset(dataset, estimator, *search ? *search : estimator.time_offset_search(), &result.calibration);
   if (refine && result.status == "ok") {
     solve_log.SetPhase("refinement");
     RefineEstimates(request, estimator, output, &result);
@@ -504,7 +516,8 @@ RunResult RunDataset(const RunRequest& requested) {
     progress.Finish();
   }
   ReportFramesOutsideImu(dataset, *source, request.config.estimator.model.max_imu_gap_s, &result);
-  result.processing_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.processing_s =
+      earlier_pass_s + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   FinishStatus(estimator, &result);
   result.ms_per_frame = result.frames_estimated ? 1e3 * result.processing_s / result.frames_estimated : 0.0;
   result.real_time_factor = result.processing_s > 0 ? result.dataset_duration_s / result.processing_s : 0.0;
@@ -517,6 +530,28 @@ RunResult RunDataset(const RunRequest& requested) {
   if (request.output_covariance) output.WriteCovariance();
   if (result.nees) output.WriteNees(*result.nees);
   return result;
+}
+
+}  // namespace
+
+// The time offset search at initialization found the camera-IMU offset beyond its prior: the run
+// starts again from the first frame with the prior there (docs/calibration.md).
+RunResult RunDataset(const RunRequest& requested) {
+  ValidateRunConfig(requested.config);
+  ValidateRequest(requested);
+  WarnAboutQuestionableSettings(requested.config);
+  const EurocDataset dataset = ReadRunDataset(requested);
+  std::optional<Estimator::TimeOffsetSearchReport> search;
+  const RunResult first = RunPass(requested, dataset, &search, 0.0);
+  if (!search) return first;
+  RunRequest again = requested;
+  again.config.estimator.model.time_offset_prior_mean_ms = 1e3 * search->offset_s;
+  again.config.estimator.model.time_offset_search_ms = 0;
+  LOG(WARNING) << "the camera-IMU time offset is " << 1e3 * search->offset_s << " +- " << 1e3 * search->sigma_s
+               << " ms, beyond its prior (time_offset_prior_mean_ms " << requested.config.estimator.model.time_offset_prior_mean_ms
+               << " +- " << requested.config.estimator.model.time_offset_prior_sigma_ms
+               << " ms): starting again from the first frame with the prior's mean there";
+  return RunPass(again, dataset, &search, first.processing_s);
 }
 
 }  // namespace vio::tools

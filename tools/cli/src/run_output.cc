@@ -163,6 +163,11 @@ void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_jso
       << ", \"time_offset_ms\": " << JsonNumber(r.calibration.time_offset_ms)
       << ", \"time_offset_calibration_ms\": " << JsonNumber(r.calibration.time_offset_calibration_ms);
   if (r.calibration.time_offset_sigma_ms) out << ", \"time_offset_sigma_ms\": " << JsonNumber(*r.calibration.time_offset_sigma_ms);
+  if (r.calibration.time_offset_search_ms) {
+    out << ", \"time_offset_search\": {\"offset_ms\": " << JsonNumber(*r.calibration.time_offset_search_ms)
+        << ", \"sigma_ms\": " << JsonNumber(*r.calibration.time_offset_search_sigma_ms)
+        << ", \"restarted\": " << (r.calibration.time_offset_search_restarted ? "true" : "false") << "}";
+  }
   out << "}";
   if (r.groundtruth_tilt_deg) out << ",\n  \"groundtruth_tilt_deg\": " << JsonNumber(*r.groundtruth_tilt_deg);
   if (r.evaluation) {

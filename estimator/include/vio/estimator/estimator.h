@@ -17,6 +17,7 @@
 #include "vio/estimator/policy.h"
 #include "vio/estimator/refinement.h"
 #include "vio/estimator/rig_checks.h"
+#include "vio/estimator/time_offset_search.h"
 #include "vio/estimator/tracking_monitor.h"
 #include "vio/estimator/window.h"
 #include "vio/estimator/window_covariance.h"
@@ -64,6 +65,16 @@ class Estimator {
   double time_offset_s() const;
   /// Its marginal standard deviation at the current estimate [s]; nothing when not estimated.
   std::optional<double> TimeOffsetSigma() { return window_.TimeOffsetSigma(); }
+  /// The coarse time offset search at initialization, once it decided.
+  struct TimeOffsetSearchReport {
+    double offset_s = 0;  ///< where the gyro follows the camera best [s]
+    double sigma_s = 0;   ///< its standard deviation (optimistic: the frame pairs overlap) [s]
+    int pairs = 0;        ///< frame pairs compared
+    /// It lies beyond the prior: the windows so far were linearized that far off, and a run from the
+    /// start with the prior's mean there (time_offset_prior_mean_ms) is recommended.
+    bool restart = false;
+  };
+  const std::optional<TimeOffsetSearchReport>& time_offset_search() const { return time_offset_search_; }
 
   /// Ends the run. For an offline policy (batch) this is where it solves;
   /// it then returns the final estimate of every state (which replaces the
@@ -129,8 +140,14 @@ class Estimator {
   /// The dynamic initializer's gravity and biases against the rig's limits; an implausible result
   /// `kImplausibleInits` attempts in a row is an input problem. Empty when plausible.
   std::string CheckDynamicResult(const DynamicInitResult& result);
-  /// The gyro's rotation against the camera's from the previous frame to this one (RotationCheck).
-  void CheckRotation(const StereoFrame& frame);
+  /// The gyro's rotation against the camera's from the previous frame to this one (RotationCheck,
+  /// and the time offset search while it runs, at `search_t_ns`: the camera stamp less the prior's mean).
+  void CheckRotation(const StereoFrame& frame, Timestamp search_t_ns);
+  /// With the offset estimated and time_offset_search_ms > 0: the search starts.
+  void StartTimeOffsetSearch();
+  /// The search's result: an input problem when it lies at its range's end, a recommended restart
+  /// when beyond the prior (TimeOffsetSearchReport).
+  void ApplyTimeOffsetSearch(const TimeOffsetSearch::Result& result);
   /// Dynamic initialization from the buffered frames ending at this one.
   bool TryDynamic(std::string* reason);
   /// The buffered frames (time order) from t_ns - span_s on.
@@ -171,9 +188,13 @@ class Estimator {
   struct RotationCheckFrame {
     StereoFrame frame;
     Eigen::Vector3d gyro_sum;  ///< the gyro integrated from the first frame kept (IntegratedGyro) [rad]
+    Timestamp search_t_ns;     ///< its time for the time offset search (CheckRotation)
   };
   RotationCheck rotation_check_;
   std::deque<RotationCheckFrame> rotation_frames_;  ///< the last RotationCheck::kPairSpanS, until it decided
+  std::optional<TimeOffsetSearch> offset_search_;  ///< while the coarse time offset search runs
+  Timestamp offset_search_start_ns_ = -1;           ///< the first frame the search saw
+  std::optional<TimeOffsetSearchReport> time_offset_search_;  ///< its result, once decided
   int implausible_inits_ = 0;                   ///< dynamic initializations in a row that were implausible
   std::string input_problem_;
   std::optional<MeasurementLog> log_;  ///< with KeepMeasurements: every state's measurements

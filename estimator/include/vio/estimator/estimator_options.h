@@ -217,6 +217,7 @@ struct ModelOptions {
   bool estimate_time_offset = true;       ///< the camera-IMU time offset is a state of the window
   double time_offset_prior_mean_ms = 0.0;   ///< prior mean of the offset (fixed when not estimated) [ms]
   double time_offset_prior_sigma_ms = 5.0;  ///< prior standard deviation of the offset [ms]
+  double time_offset_search_ms = 100.0;  ///< range of the coarse search at initialization, either side [ms]; 0: none
 
   template <class V>
   void Visit(V& v) {
@@ -247,6 +248,11 @@ struct ModelOptions {
       Between(-1000, 1000));
     v("time_offset_prior_sigma_ms", time_offset_prior_sigma_ms,
       "camera-IMU time offset's prior standard deviation [ms]", Positive());
+    v("time_offset_search_ms", time_offset_search_ms,
+      "with estimate_time_offset: in the first seconds of rotation the gyro is matched to the camera for offsets "
+      "this far either side of time_offset_prior_mean_ms; a match beyond the prior starts the run again with the "
+      "prior's mean there, one at the range's end stops it (bad_input); 0: no search [ms]",
+      Between(0, 1000));
   }
 };
 

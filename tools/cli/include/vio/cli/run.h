@@ -75,6 +75,11 @@ struct CalibrationReport {
   double time_offset_ms = 0;  ///< an image stamped t was taken at IMU time t - offset [ms] (calibration's + estimate)
   double time_offset_calibration_ms = 0;  ///< the calibration's (Kalibr's -timeshift_cam_imu), applied first [ms]
   std::optional<double> time_offset_sigma_ms;  ///< marginal standard deviation, when estimated [ms]
+  /// The coarse search at initialization (time_offset_search_ms), when it decided: its offset
+  /// (calibration's + found) and standard deviation [ms], and whether the run started again with the
+  /// prior's mean there (the offset lay beyond the prior).
+  std::optional<double> time_offset_search_ms, time_offset_search_sigma_ms;
+  bool time_offset_search_restarted = false;
 };
 
 struct RunResult {
@@ -99,7 +104,8 @@ struct RunResult {
   int frames = 0;                ///< frames in the dataset
   int frames_estimated = 0;      ///< frames with a pose in trajectory.txt
   double dataset_duration_s = 0; ///< first to last frame [s]
-  double processing_s = 0;       ///< wall time of the estimator loop [s]
+  /// Wall time of the estimator loop [s]; both passes when the time offset search started the run again.
+  double processing_s = 0;
   double ms_per_frame = 0;       ///< mean over estimated frames [ms]
   double real_time_factor = 0;   ///< dataset_duration_s / processing_s
   double peak_memory_mb = 0;     ///< peak resident set size of the process (getrusage) [MiB]
