@@ -1,6 +1,6 @@
 // Rigs that cannot be right, through the real binary: `vio simulate` writes the mistakes users make
 // (the gyro in deg/s, the accelerometer in g, the cameras swapped; a camera-IMU clock offset of 2 s by
-// shifting imu0/data.csv), and `vio run` must stop with status bad_input and a problem that names
+// shifting imu0/data.csv; the images exchanged), and `vio run` must stop with status bad_input and a problem that names
 // the mistake and its fix, exit code 1, never crash, and write what it estimated (trajectory.txt,
 // summary.json, timing.csv). The same flight written right runs ok.
 #include <cstdint>
@@ -102,6 +102,16 @@ TEST(BadRig, AccelerometerInGFromAMovingStart) {
 TEST(BadRig, SwappedCameras) {
   const std::string dataset = Simulated("rig_swapped", "--swap_cameras");
   ExpectBadInput(RunOn(dataset, "rig_swapped_run"), "with cam0 and cam1 exchanged (0 as given): are the cameras swapped?");
+}
+
+// The images exchanged (rendered with the true rig, written as cam1's and cam0's): the image front
+// end's own check (stereo_swap_check.h).
+TEST(BadRig, SwappedImages) {
+  const std::string dir = test::MakeTempDir("rig_swapped_images") + "/dataset";
+  ASSERT_EQ(vio::Run(std::string(VIO_BINARY) + " simulate --output_dir=" + dir +
+                " --duration_s=4 --seed=2 --camera=images --swap_cameras"),
+            0);
+  ExpectBadInput(RunOn(dir, "rig_swapped_images_run"), "the stereo images match only with cam0 and cam1 exchanged");
 }
 
 // The IMU's clock 2 s ahead of the camera's: every IMU stamp moved 2 s earlier.

@@ -14,6 +14,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vio/frontend/stereo_frontend.h"
+#include "vio/frontend/stereo_swap_check.h"
 #include "vio/frontend/track_drawing.h"
 #include "pair_pipeline.h"
 #include "vio/dataset/image_file.h"
@@ -66,6 +67,7 @@ class ImageFrameSource final : public FrameSource {
         mav0_(dataset.root + "/mav0"),
         debug_dir_(options.debug_images),
         frontend_(frontend::MakeStereoFrontend(options, rectifier)),
+        swap_check_(rectifier),
         threads_(PipelineThreads(options.pipeline_threads)) {
     for (int i = 0; i < 2; ++i) {
       filenames_[i].reserve(dataset.frames[i].size());
@@ -103,6 +105,7 @@ class ImageFrameSource final : public FrameSource {
     prior.T_w_b = estimator.PredictBodyPose(pair.t_ns);
     prior.landmarks = &estimator.window().landmarks();
     const double cpu_start_ms = ThreadCpuMs();
+    swap_check_.Add(slot.pair->left, slot.pair->right);
     StereoFrame frame = frontend_->Process(pair.t_ns, slot.pair.get(), prior);
     frontend_->AddPrepareTime(prepare_here_ms);
     frontend_cpu_ms_ += ThreadCpuMs() - cpu_start_ms;
@@ -112,6 +115,7 @@ class ImageFrameSource final : public FrameSource {
   }
 
   std::string ReportJson() const override;
+  std::string InputProblem() const override { return swap_check_.problem(); }
 
  private:
   struct Pair {
@@ -177,6 +181,7 @@ class ImageFrameSource final : public FrameSource {
   std::string mav0_;
   std::string debug_dir_;
   std::unique_ptr<frontend::StereoFrontend> frontend_;
+  frontend::StereoSwapCheck swap_check_;  ///< on the first pairs
   frontend::TrackDrawer drawer_;
   std::vector<std::string> filenames_[2];
   std::optional<BagImageReader> bag_readers_[2];  ///< images from a ROS 1 bag: one sequential reader per camera
