@@ -247,7 +247,7 @@ class McapFetcher final : public MessageFetcher, McapFile {
  private:
   struct Slot {
     std::uint64_t at = MessagePlace::kNoChunk;
-    std::vector<std::uint8_t> record, inflated;
+    std::vector<std::uint8_t> records;  ///< the chunk's records, decompressed
     ChunkRecords chunk;
   };
 
@@ -262,8 +262,11 @@ class McapFetcher final : public MessageFetcher, McapFile {
     recent_ = 1 - recent_;
     Slot& slot = slots_[recent_];
     slot.at = MessagePlace::kNoChunk;
-    ReadRecord(at, mcap::kChunk, &slot.record);
-    slot.chunk = OpenChunk(slot.record, at, /*check_crc=*/false, &slot.inflated);
+    ReadRecord(at, mcap::kChunk, &record_);
+    slot.chunk = OpenChunk(record_, at, /*check_crc=*/false, &slot.records);
+    // An uncompressed chunk's records are inside the record: the slot keeps
+    // that buffer (a swap moves no bytes; the pointer stays valid).
+    if (slot.chunk.data != slot.records.data()) slot.records.swap(record_);
     slot.at = at;
     return slot;
   }
@@ -296,6 +299,7 @@ class McapFetcher final : public MessageFetcher, McapFile {
 
   Slot slots_[2];
   std::ptrdiff_t recent_ = 0;       ///< the slot used last
+  std::vector<std::uint8_t> record_;  ///< the last chunk record read, compressed
   std::vector<std::uint8_t> single_;  ///< a message record outside chunks
 };
 

@@ -2,7 +2,8 @@
 // The storage of ROS 2 recordings without ROS: MCAP files (mcap_reader.cc,
 // mcap_writer.cc) and rosbag2 sqlite3 files (rosbag2_sqlite.cc), each read as
 // its messages in file order, and bag folders (metadata.yaml naming one or
-// several such files). Errors are DatasetErrors naming the file.
+// several such files); messages read again at the places a first read found
+// (MessageFetcher). Errors are DatasetErrors naming the file.
 #include <cstdint>
 #include <memory>
 #include <set>
