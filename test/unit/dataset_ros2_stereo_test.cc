@@ -1,7 +1,10 @@
 // Ros2StereoImageReader: the images of both cameras read at the places
 // ReadRos2Bag found them, in any order and across several MCAP chunks (zstd,
-// lz4, none) and .db3 rows, equal the ASL folder's; a recording cut short
-// after the first read is an error naming the file, not a crash.
+// lz4, none), outside chunks and .db3 rows of one or several files (the
+// latter two written by the independent writer of tools/ros2_testdata),
+// equal the ASL folder's; a recording cut short after the first read is an
+// error naming the file, not a crash.
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -18,9 +21,10 @@ constexpr Timestamp kStartNs = 1'403'715'274'302'142'976;
 constexpr Timestamp kFrameNs = 50'000'000;
 constexpr int kFrames = 24;
 
-// Distinct per camera and frame; 640x480, so the frames span several 4 MB chunks.
-cv::Mat FrameImage(int camera, int k) {
-  cv::Mat image(480, 640, CV_8UC1);
+// Distinct per camera and frame; 640x480 (by default), so the frames span
+// several 4 MB chunks.
+cv::Mat FrameImage(int camera, int k, int rows = 480, int cols = 640) {
+  cv::Mat image(rows, cols, CV_8UC1);
   for (int r = 0; r < image.rows; ++r) {
     for (int c = 0; c < image.cols; ++c) {
       image.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(r * 3 + c * (camera + 1) + 11 * k);
@@ -29,7 +33,7 @@ cv::Mat FrameImage(int camera, int k) {
   return image;
 }
 
-EurocDataset WriteAsl(const std::string& root) {
+EurocDataset WriteAsl(const std::string& root, int rows = 480, int cols = 640) {
   EurocDataset d;
   d.root = root;
   for (int i = 0; i < 10 * kFrames; ++i) {
@@ -45,23 +49,25 @@ EurocDataset WriteAsl(const std::string& root) {
   for (int i = 0; i < 2; ++i) {
     const std::string folder = root + "/mav0/cam" + std::to_string(i) + "/data/";
     std::filesystem::create_directories(folder);
-    for (int k = 0; k < kFrames; ++k) cv::imwrite(folder + std::to_string(k) + ".png", FrameImage(i, k));
+    for (int k = 0; k < kFrames; ++k) cv::imwrite(folder + std::to_string(k) + ".png", FrameImage(i, k, rows, cols));
   }
   return ReadEuroc(root);
 }
 
-void ExpectImages(const std::string& path) {
+void ExpectImages(const std::string& path, int rows = 480, int cols = 640) {
   SCOPED_TRACE(path);
   const EurocDataset bag = ReadRos2Bag(path, BagTopics{});
   ASSERT_EQ(bag.frames[0].size(), static_cast<size_t>(kFrames));
   Ros2StereoImageReader reader(bag);
   // Pairs forward, then single images backwards and jumping between chunks.
   for (int k = 0; k < kFrames; ++k) {
-    for (int i = 0; i < 2; ++i) EXPECT_EQ(cv::norm(reader.Read(i, k), FrameImage(i, k), cv::NORM_INF), 0.0) << i << k;
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_EQ(cv::norm(reader.Read(i, k), FrameImage(i, k, rows, cols), cv::NORM_INF), 0.0) << i << k;
+    }
   }
   for (int k : {23, 0, 12, 1, 22, 5, 5}) {
     const int i = k % 2;
-    EXPECT_EQ(cv::norm(reader.Read(i, k), FrameImage(i, k), cv::NORM_INF), 0.0) << i << k;
+    EXPECT_EQ(cv::norm(reader.Read(i, k), FrameImage(i, k, rows, cols), cv::NORM_INF), 0.0) << i << k;
   }
   EXPECT_THROW(reader.Read(0, kFrames), DatasetError);
 }
@@ -79,6 +85,31 @@ TEST(Ros2Stereo, EveryStorageGivesTheAslImagesInAnyOrder) {
   WriteRos2Bag(asl, dir + "/folder", BagTopics{}, Ros2WriteOptions{"mcap", "zstd"});
   ExpectImages(dir + "/folder");
   EXPECT_GT(std::filesystem::file_size(dir + "/data_none.mcap"), std::uintmax_t{3} * (4 << 20));  // several chunks
+}
+
+// Runs a command of tools/ros2_testdata; fails the test when it fails.
+void RunTool(const std::string& command, const std::string& log) {
+  const int status = std::system(("cd " + test::SourceDir() + "/tools/ros2_testdata && " + command + " > " + log +
+                                  " 2>&1").c_str());
+  ASSERT_EQ(status, 0) << command << " (log: " << log << ")";
+}
+
+TEST(Ros2Stereo, MessagesOutsideChunksAndSeveralDb3FilesOfAnIndependentWriter) {
+  if (std::system("node --version > /dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "node is not installed: tools/install_deps.sh test installs it";
+  }
+  ASSERT_TRUE(std::filesystem::is_directory(test::SourceDir() + "/tools/ros2_testdata/node_modules/@mcap/core"))
+      << "tools/ros2_testdata has no node_modules: run tools/install_deps.sh test (npm ci there)";
+  const std::string dir = test::MakeTempDir("ros2_stereo_foxglove");
+  const EurocDataset asl = WriteAsl(dir + "/asl", 48, 64);
+  for (const std::string compression : {"unchunked", "zstd"}) {
+    const std::string out = dir + "/" + compression + ".mcap";
+    RunTool("node write_bag.js --asl=" + asl.root + " --out=" + out + " --compression=" + compression, out + ".log");
+    ExpectImages(out, 48, 64);
+  }
+  RunTool("node write_bag.js --format=jsonl --asl=" + asl.root + " --out=" + dir + "/messages.jsonl", dir + "/jsonl.log");
+  RunTool("python3 write_db3.py " + dir + "/messages.jsonl " + dir + "/jazzy --layout=jazzy --files=3", dir + "/jazzy.log");
+  ExpectImages(dir + "/jazzy", 48, 64);
 }
 
 TEST(Ros2Stereo, ARecordingCutShortAfterTheFirstReadIsAnError) {

@@ -232,7 +232,8 @@ class McapFetcher final : public MessageFetcher, McapFile {
   void Fetch(const MessagePlace& place, Message* message) override {
     if (place.inner == MessagePlace::kNoChunk) {
       ReadRecord(place.record, mcap::kMessage, &single_);
-      return Parse(single_.data(), single_.size(), place.record, message);
+      Parse(single_.data(), single_.size(), place.record, message);
+      return;
     }
     const Slot& slot = Chunk(place.record);
     if (place.inner >= slot.chunk.size) Corrupt("a message place past its chunk's end", place.record);
