@@ -18,14 +18,14 @@ packages_of() {
   case "$1" in
     build) echo build-essential cmake ninja-build pkg-config libceres-dev libeigen3-dev libopencv-dev libdeflate-dev \
                 libgoogle-glog-dev libgflags-dev libyaml-cpp-dev librosbag-storage-dev libsensor-msgs-dev \
-                libzstd-dev liblz4-dev libsqlite3-dev zlib1g-dev ;;
+                libzstd-dev liblz4-dev libsqlite3-dev ;;
     test) echo libgtest-dev libgmock-dev libbenchmark-dev "$(command -v node > /dev/null || echo nodejs npm)" ;;
     plot) echo python3 python3-numpy python3-matplotlib ;;
     runtime) echo libceres3 libopencv-core406 libopencv-imgproc406 libopencv-imgcodecs406 \
                   libopencv-features2d406 libopencv-calib3d406 libopencv-video406 libdeflate0 \
                   libgoogle-glog0v6 libgflags2.2 libyaml-cpp0.7 \
                   librosbag-storage4d libroscpp-serialization0d librostime1d libcpp-common0d \
-                  libconsole-bridge1.0 libzstd1 liblz4-1 libsqlite3-0 zlib1g python3 python3-numpy python3-matplotlib ;;
+                  libconsole-bridge1.0 libzstd1 liblz4-1 libsqlite3-0 python3 python3-numpy python3-matplotlib ;;
     docker) echo docker.io debootstrap ;;
     slurm) echo slurm-wlm munge ;;
     *) echo "install_deps: unknown group '$1' (build, test, plot, runtime, docker, slurm)" >&2; return 1 ;;

@@ -73,7 +73,9 @@ class ImageFrameSource final : public FrameSource {
       filenames_[i].reserve(dataset.frames[i].size());
       for (const CameraFrame& f : dataset.frames[i]) filenames_[i].push_back(f.filename);
       if (dataset.image_bag.empty()) continue;
-      if (IsRos2BagPath(dataset.image_bag)) {
+      if (dataset.ros2_images) {
+        if (!ros2_images_) ros2_images_.emplace(dataset);
+      } else if (IsRos2BagPath(dataset.image_bag)) {
         ros2_readers_[i].emplace(dataset.image_bag, dataset.image_topics[i]);
       } else {
         bag_readers_[i].emplace(dataset.image_bag, dataset.image_topics[i]);
@@ -161,6 +163,10 @@ class ImageFrameSource final : public FrameSource {
       *image = bag_readers_[camera]->Read(row);
       return;
     }
+    if (ros2_images_) {
+      *image = ros2_images_->Read(camera, row);
+      return;
+    }
     if (ros2_readers_[camera]) {
       *image = ros2_readers_[camera]->Read(row);
       return;
@@ -185,7 +191,8 @@ class ImageFrameSource final : public FrameSource {
   frontend::TrackDrawer drawer_;
   std::vector<std::string> filenames_[2];
   std::optional<BagImageReader> bag_readers_[2];  ///< images from a ROS 1 bag: one sequential reader per camera
-  std::optional<Ros2ImageReader> ros2_readers_[2];  ///< or from a ROS 2 recording
+  std::optional<Ros2StereoImageReader> ros2_images_;  ///< or from a ROS 2 recording read by ReadRos2Bag
+  std::optional<Ros2ImageReader> ros2_readers_[2];    ///< or from one read otherwise
   std::vector<Pair> pairs_;
   int unpaired_ = 0;
   double load_ms_ = 0;          ///< waiting for images (wall clock)

@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <fstream>
 
+#include <libdeflate.h>
 #include <lz4frame.h>
-#include <zlib.h>
 #include <zstd.h>
 
 #include "mcap_format.h"
@@ -113,7 +113,7 @@ class McapWriter final : public MessageWriter {
     chunk.Put(static_cast<std::uint64_t>(start_ns_));
     chunk.Put(static_cast<std::uint64_t>(end_ns_));
     chunk.Put(static_cast<std::uint64_t>(raw.size()));
-    chunk.Put(static_cast<std::uint32_t>(crc32_z(0L, raw.data(), raw.size())));
+    chunk.Put(static_cast<std::uint32_t>(libdeflate_crc32(0, raw.data(), raw.size())));
     chunk.String(compression_);
     chunk.Put(static_cast<std::uint64_t>(records.size()));
     chunk.Raw(records.data(), records.size());

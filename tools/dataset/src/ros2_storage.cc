@@ -80,6 +80,12 @@ bool BagReader::Next(Message* message) {
   return true;
 }
 
+MessagePlace BagReader::Place() const {
+  MessagePlace place = reader_->Place();
+  place.file = index_;
+  return place;
+}
+
 std::vector<Topic> BagReader::Topics() const {
   std::vector<Topic> all = seen_;
   for (Topic& topic : reader_->Topics()) all.push_back(std::move(topic));

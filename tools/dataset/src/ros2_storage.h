@@ -2,7 +2,8 @@
 // The storage of ROS 2 recordings without ROS: MCAP files (mcap_reader.cc,
 // mcap_writer.cc) and rosbag2 sqlite3 files (rosbag2_sqlite.cc), each read as
 // its messages in file order, and bag folders (metadata.yaml naming one or
-// several such files). Errors are DatasetErrors naming the file.
+// several such files); messages read again at the places a first read found
+// (MessageFetcher). Errors are DatasetErrors naming the file.
 #include <cstdint>
 #include <memory>
 #include <set>
@@ -27,12 +28,25 @@ struct Message {
   size_t size = 0;
 };
 
+/// Where a message lives in a recording, for reading it again: MCAP, the file
+/// offset of its chunk record and its record's offset inside the
+/// decompressed chunk (outside chunks: its record's file offset, inner
+/// kNoChunk); sqlite3, its row id (record).
+struct MessagePlace {
+  static constexpr std::uint64_t kNoChunk = ~std::uint64_t{0};
+  size_t file = 0;  ///< index into BagFiles::files
+  std::uint64_t record = 0;
+  std::uint64_t inner = kNoChunk;
+};
+
 /// The messages of one storage file, in file order.
 class MessageReader {
  public:
   virtual ~MessageReader() = default;
   /// The next message of one of the topics asked for; false after the last.
   virtual bool Next(Message* message) = 0;
+  /// Where the last message returned lives (file 0).
+  virtual MessagePlace Place() const = 0;
   /// The file's topics (MCAP: those whose channel was read so far).
   virtual std::vector<Topic> Topics() const = 0;
 };
@@ -40,6 +54,19 @@ class MessageReader {
 /// `topics`: the topic names to return messages of (empty: all).
 std::unique_ptr<MessageReader> OpenMcap(const std::string& path, const std::set<std::string>& topics);
 std::unique_ptr<MessageReader> OpenSqlite(const std::string& path, const std::set<std::string>& topics);
+
+/// Messages of one storage file read again at places a MessageReader gave
+/// (MCAP chunk CRCs are not checked again: the reader did).
+class MessageFetcher {
+ public:
+  virtual ~MessageFetcher() = default;
+  /// The message at `place` (its bytes and log time; `topic` is left as is),
+  /// valid until the next Fetch.
+  virtual void Fetch(const MessagePlace& place, Message* message) = 0;
+};
+
+std::unique_ptr<MessageFetcher> OpenMcapFetcher(const std::string& path);
+std::unique_ptr<MessageFetcher> OpenSqliteFetcher(const std::string& path);
 
 /// Writes one storage file; topics are indices into the list given at creation.
 class MessageWriter {
@@ -73,6 +100,8 @@ class BagReader {
   bool Next(Message* message);
   /// The file of the last message.
   const std::string& file() const { return bag_.files[index_]; }
+  /// Where the last message lives.
+  MessagePlace Place() const;
   /// Every topic of the files opened so far, once each.
   std::vector<Topic> Topics() const;
 

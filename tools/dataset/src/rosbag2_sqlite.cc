@@ -72,7 +72,7 @@ class SqliteReader final : public MessageReader {
       topic.encoding = Text(db_.statement(), 3);
       if (wanted.empty() || wanted.count(topic.name)) ids += (ids.empty() ? "" : ",") + std::to_string(id);
     }
-    db_.Prepare("SELECT topic_id, timestamp, data FROM messages" +
+    db_.Prepare("SELECT topic_id, timestamp, data, id FROM messages" +
                 (wanted.empty() ? std::string() : " WHERE topic_id IN (" + ids + ")") + " ORDER BY id");
   }
 
@@ -86,8 +86,11 @@ class SqliteReader final : public MessageReader {
     message->log_time_ns = sqlite3_column_int64(s, 1);
     message->data = static_cast<const std::uint8_t*>(sqlite3_column_blob(s, 2));
     message->size = static_cast<size_t>(sqlite3_column_bytes(s, 2));
+    place_.record = static_cast<std::uint64_t>(sqlite3_column_int64(s, 3));
     return true;
   }
+
+  MessagePlace Place() const override { return place_; }
 
   std::vector<Topic> Topics() const override {
     std::vector<Topic> topics;
@@ -98,6 +101,28 @@ class SqliteReader final : public MessageReader {
  private:
   Database db_;
   std::map<std::int64_t, Topic> topics_;
+  MessagePlace place_;  ///< of the last message
+};
+
+// Messages read again by their row ids.
+class SqliteFetcher final : public MessageFetcher {
+ public:
+  explicit SqliteFetcher(const std::string& path) : db_(path, SQLITE_OPEN_READONLY) {
+    db_.Prepare("SELECT timestamp, data FROM messages WHERE id = ?");
+  }
+
+  void Fetch(const MessagePlace& place, Message* message) override {
+    sqlite3_stmt* s = db_.statement();
+    sqlite3_reset(s);
+    sqlite3_bind_int64(s, 1, static_cast<std::int64_t>(place.record));
+    if (!db_.Step()) db_.Fail("no message of id " + std::to_string(place.record) + " any more");
+    message->log_time_ns = sqlite3_column_int64(s, 0);
+    message->data = static_cast<const std::uint8_t*>(sqlite3_column_blob(s, 1));
+    message->size = static_cast<size_t>(sqlite3_column_bytes(s, 1));
+  }
+
+ private:
+  Database db_;
 };
 
 class SqliteWriter final : public MessageWriter {
@@ -147,6 +172,11 @@ class SqliteWriter final : public MessageWriter {
 std::unique_ptr<MessageReader> OpenSqlite(const std::string& path, const std::set<std::string>& topics) {
   if (!std::filesystem::is_regular_file(path)) throw DatasetError(path + ": no such sqlite3 file");
   return std::make_unique<SqliteReader>(path, topics);
+}
+
+std::unique_ptr<MessageFetcher> OpenSqliteFetcher(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw DatasetError(path + ": no such sqlite3 file");
+  return std::make_unique<SqliteFetcher>(path);
 }
 
 std::unique_ptr<MessageWriter> CreateSqlite(const std::string& path, const std::vector<Topic>& topics) {

@@ -316,19 +316,22 @@ void WriteAslFromBag(const EurocDataset& dataset, const std::string& root) {
   EurocDataset asl = dataset;
   asl.image_bag.clear();
   WriteEuroc(asl, root);
+  std::optional<Ros2StereoImageReader> ros2_images;
+  if (dataset.ros2_images) ros2_images.emplace(dataset);
   for (int camera = 0; camera < 2; ++camera) {
     const std::string folder = root + "/mav0/cam" + std::to_string(camera) + "/data/";
     std::filesystem::create_directories(folder);
     std::optional<BagImageReader> ros1;
     std::optional<Ros2ImageReader> ros2;
-    if (IsRos2BagPath(dataset.image_bag)) {
+    if (!ros2_images && IsRos2BagPath(dataset.image_bag)) {
       ros2.emplace(dataset.image_bag, dataset.image_topics[camera]);
-    } else {
+    } else if (!ros2_images) {
       ros1.emplace(dataset.image_bag, dataset.image_topics[camera]);
     }
     for (size_t k = 0; k < dataset.frames[camera].size(); ++k) {
       const std::string file = folder + dataset.frames[camera][k].filename;
-      if (!cv::imwrite(file, ros2 ? ros2->Read(k) : ros1->Read(k))) throw DatasetError(file + ": cannot write the image");
+      const cv::Mat image = ros2_images ? ros2_images->Read(camera, k) : ros2 ? ros2->Read(k) : ros1->Read(k);
+      if (!cv::imwrite(file, image)) throw DatasetError(file + ": cannot write the image");
     }
   }
 }

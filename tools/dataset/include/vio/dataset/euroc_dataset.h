@@ -63,6 +63,8 @@ struct ImuGapReport {
   Timestamp longest_ns = 0;  ///< longest gap [ns]
 };
 
+struct Ros2ImageIndex;  // ros2_dataset.cc
+
 /// What a sequence folder holds. Optional parts are empty when absent.
 struct EurocDataset {
   std::string root;  ///< the folder holding mav0/
@@ -82,6 +84,8 @@ struct EurocDataset {
   /// images are the files of mav0/camN/data/.
   std::string image_bag;
   std::string image_topics[2];
+  /// Where ReadRos2Bag found each image message of image_bag (ros2_dataset.h); null otherwise.
+  std::shared_ptr<const Ros2ImageIndex> ros2_images;
   std::vector<GroundTruthState> groundtruth;
   std::vector<FeatureObservation> features;  ///< features0, sorted by (t, camera, id)
   /// features0/data.csv when it was checked but not kept (EurocReadOptions::stream_features)

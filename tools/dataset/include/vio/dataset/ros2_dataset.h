@@ -9,8 +9,9 @@
 // optional ground truth geometry_msgs/msg/PoseStamped, TransformStamped or
 // nav_msgs/msg/Odometry. A recording carries no calibration.
 //
-// Streamed like ReadBag: ReadRos2Bag keeps the IMU, the ground truth and the
-// image stamps; Ros2ImageReader decodes one image at a time, in order.
+// Streamed like ReadBag: ReadRos2Bag keeps the IMU, the ground truth, the
+// image stamps and where each image message lives; Ros2StereoImageReader
+// (or Ros2ImageReader, one topic in order) decodes one image at a time.
 #include <memory>
 #include <string>
 
@@ -41,6 +42,26 @@ class Ros2ImageReader {
   Ros2ImageReader& operator=(Ros2ImageReader&&) noexcept;
   /// The index-th image. Throws DatasetError past the end or on a bad message.
   cv::Mat Read(size_t index);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Both cameras' images of a recording read by ReadRos2Bag, each read where
+/// that first read found it (`dataset.ros2_images`), in any order: an MCAP
+/// chunk is decompressed once for both cameras while it is one of the last
+/// two used (its CRC was checked by ReadRos2Bag), a .db3 row read by its id.
+/// Memory stays at two chunks.
+class Ros2StereoImageReader {
+ public:
+  /// Throws DatasetError when `dataset` was not read by ReadRos2Bag.
+  explicit Ros2StereoImageReader(const EurocDataset& dataset);
+  ~Ros2StereoImageReader();
+  Ros2StereoImageReader(Ros2StereoImageReader&&) noexcept;
+  Ros2StereoImageReader& operator=(Ros2StereoImageReader&&) noexcept;
+  /// The index-th image of camera 0 or 1. Throws DatasetError past the end or on a bad message.
+  cv::Mat Read(int camera, size_t index);
 
  private:
   struct Impl;
