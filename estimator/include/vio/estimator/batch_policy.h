@@ -10,6 +10,7 @@
 // policies.
 #include <set>
 
+#include "vio/estimator/frozen_observations.h"
 #include "vio/estimator/policy.h"
 
 namespace vio {
@@ -27,6 +28,7 @@ class BatchPolicy final : public Policy {
 
   EstimatorOptions options_;
   std::set<StateId> active_;  ///< states not yet frozen, oldest first
+  FrozenObservations frozen_;  ///< the frozen states' observations, for the periodic solves
   int frames_ = 0;
 };
 

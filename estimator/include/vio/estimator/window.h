@@ -22,6 +22,7 @@
 
 #include "vio/estimator/estimator_options.h"
 #include "vio/estimator/first_estimates.h"
+#include "vio/estimator/frozen_observations.h"
 #include "vio/estimator/gauss_newton.h"
 #include "vio/estimator/imu_preintegration.h"
 #include "vio/estimator/solve_control.h"
@@ -159,6 +160,13 @@ class Window {
   /// sparse Cholesky, segments of states and the landmarks only they see first (EliminationGroups).
   /// Depends only on the values, not on the heap layout (batch's solves; window_sparse_solve.cc).
   SolveReport SolveSparse(const SolverOptions& options);
+  /// SolveSparse with the observations from constant states replaced by their summaries in
+  /// `frozen` (frozen_observations.h): batch's periodic solves. Every constant state's
+  /// observations must be in `frozen`.
+  SolveReport SolveSparse(const SolverOptions& options, const FrozenObservations& frozen);
+  /// Adds the observations of `state` at the current values to `frozen`, before the state is
+  /// held constant for good; the landmarks they see must be variable.
+  void SummarizeObservationsOf(StateId state, FrozenObservations& frozen) const;
   /// Re-preintegrates IMU factors whose gyro-bias linearization moved too far.
   int RefreshImuFactors(double gyro_bias_threshold);
   /// J^T J of the whole cost at the current values over the tangent spaces of the states'
@@ -260,9 +268,20 @@ class Window {
   SolveReport GaussNewton(int max_steps, bool until_converged, const SolverOptions& options);
   SolveReport LevenbergMarquardt(const ceres::Solver::Options& base, const SolverOptions& options);
   struct IdOrderedCopy;
+  /// Factors of the copy beyond the window's residuals, each on one landmark block (the caller owns them).
+  using LandmarkFactors = std::vector<std::pair<const double*, ceres::CostFunction*>>;
+  struct VariableIds {
+    std::vector<StateId> states;
+    std::vector<LandmarkId> landmarks;
+  };
+  VariableIds VariableIdsOf() const;
+  IdOrderedCopy CopyOf(const std::vector<ceres::ResidualBlockId>& residuals, const LandmarkFactors& extra) const;
   std::unordered_map<const double*, int> EliminationGroups(const std::string& linear_solver) const;
   SolveReport SolveCopy(const SolverOptions& options, const std::vector<ceres::ResidualBlockId>& residuals,
-                        const IdOrderedCopy& ids);
+                        const LandmarkFactors& extra, const IdOrderedCopy& ids);
+  /// The residuals SolveSparse(options, frozen) copies: those of the variable states (priors, IMU
+  /// factors, observations, anchored points) and the priors on the variable landmarks, in ResidualOrder().
+  std::vector<ceres::ResidualBlockId> RecentResidualOrderOf(const Leaving& solved) const;
   std::set<const double*> BlocksInPriors() const;
   /// Every residual block: priors in creation order, IMU factors and
   /// observations by ids (never by address).
