@@ -16,7 +16,10 @@ PolicyTiming BatchPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
     if (window.HasLandmark(obs.landmark)) window.SetLandmarkConstant(obs.landmark, false);
   }
   AddStereoObservations(frame, new_state, options_.model, window);
-  window.RefreshImuFactors(options_.model.reintegrate_bias_threshold);
+  // A frozen state's bias no longer moves: its IMU factor was last checked by the refresh after
+  // the solve it froze at.
+  window.RefreshImuFactors(options_.model.reintegrate_bias_threshold, refresh_from_);
+  refresh_from_ = *active_.begin();
   timing.build_ms = MillisecondsSince(start);
 
   if (++frames_ % std::max(1, options_.batch.batch_solve_every) != 0) return timing;

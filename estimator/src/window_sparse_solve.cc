@@ -72,12 +72,17 @@ struct Window::IdOrderedCopy {
 SolveReport Window::SolveSparse(const SolverOptions& options) {
   const VariableIds variable = VariableIdsOf();
   if (variable.states.empty() && variable.landmarks.empty()) return SolveReport();
+  const Leaving solved = SolvedOf(variable);
+  const std::vector<ceres::ResidualBlockId> residuals = ResidualOrderOf(solved);
+  return SolveCopy(options, residuals, {}, CopyOf(residuals, {}));
+}
+
+Window::Leaving Window::SolvedOf(const VariableIds& variable) {
   Leaving solved = LeavingOf(variable.states, variable.landmarks);
   if (estimates_time_offset() && !problem_->IsParameterBlockConstant(time_offset_)) {
     solved.blocks.insert(time_offset_);  // and its prior
   }
-  const std::vector<ceres::ResidualBlockId> residuals = ResidualOrderOf(solved);
-  return SolveCopy(options, residuals, {}, CopyOf(residuals, {}));
+  return solved;
 }
 
 Window::VariableIds Window::VariableIdsOf() const {
@@ -126,10 +131,7 @@ Window::IdOrderedCopy Window::CopyOf(const std::vector<ceres::ResidualBlockId>& 
 SolveReport Window::SolveSparse(const SolverOptions& options, const FrozenObservations& frozen) {
   const VariableIds variable = VariableIdsOf();
   if (variable.states.empty() && variable.landmarks.empty()) return SolveReport();
-  Leaving solved = LeavingOf(variable.states, variable.landmarks);
-  if (estimates_time_offset() && !problem_->IsParameterBlockConstant(time_offset_)) {
-    solved.blocks.insert(time_offset_);  // and its prior
-  }
+  const Leaving solved = SolvedOf(variable);
   std::vector<std::unique_ptr<ceres::CostFunction>> factors;
   LandmarkFactors extra;
   for (LandmarkId id : variable.landmarks) {

@@ -10,6 +10,7 @@
 //             Drop*(): remove without keeping their information.
 // Policies (policy.h) are functions over a Window.
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -167,8 +168,10 @@ class Window {
   /// Adds the observations of `state` at the current values to `frozen`, before the state is
   /// held constant for good; the landmarks they see must be variable.
   void SummarizeObservationsOf(StateId state, FrozenObservations& frozen) const;
-  /// Re-preintegrates IMU factors whose gyro-bias linearization moved too far.
-  int RefreshImuFactors(double gyro_bias_threshold);
+  /// Re-preintegrates IMU factors whose gyro-bias linearization moved too far; only those into
+  /// `first_to` and later states (batch: the others start at states frozen since they were checked).
+  int RefreshImuFactors(double gyro_bias_threshold,
+                        StateId first_to = StateId(std::numeric_limits<std::int64_t>::min()));
   /// J^T J of the whole cost at the current values over the tangent spaces of the states'
   /// [pose, speed_bias] and the landmarks, in that order, every other block held: the information
   /// of one Gauss-Newton step (after Marginalize: of the priors); its inverse is the covariance.
@@ -275,6 +278,8 @@ class Window {
     std::vector<LandmarkId> landmarks;
   };
   VariableIds VariableIdsOf() const;
+  /// The variable blocks' Leaving, with the time offset when it is estimated and variable.
+  Leaving SolvedOf(const VariableIds& variable);
   IdOrderedCopy CopyOf(const std::vector<ceres::ResidualBlockId>& residuals, const LandmarkFactors& extra) const;
   std::unordered_map<const double*, int> EliminationGroups(const std::string& linear_solver) const;
   SolveReport SolveCopy(const SolverOptions& options, const std::vector<ceres::ResidualBlockId>& residuals,
