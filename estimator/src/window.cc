@@ -235,9 +235,10 @@ void Window::SetLandmarkConstant(LandmarkId id, bool constant) {
 
 bool Window::IsStateConstant(StateId id) const { return problem_->IsParameterBlockConstant(state(id).pose); }
 
-int Window::RefreshImuFactors(double gyro_bias_threshold) {
+int Window::RefreshImuFactors(double gyro_bias_threshold, StateId first_to) {
   int refreshed = 0;
-  for (auto& [to, edge] : imu_edges_) {
+  for (auto it = imu_edges_.lower_bound(first_to); it != imu_edges_.end(); ++it) {
+    ImuEdge& edge = it->second;
     const State& from = state(edge.from);
     const ImuBias bias{from.gyro_bias(), from.accel_bias()};
     // delta_v and delta_p are linear in the accelerometer bias: the first-order

@@ -5,6 +5,8 @@
 // in one buffer filled in id order, so that order is the id order and the
 // solve depends only on the values (batch's solves; bundle adjustment).
 #include <cstring>
+#include <limits>
+#include <memory>
 #include <map>
 #include <set>
 #include <string>
@@ -13,6 +15,7 @@
 
 #include <glog/logging.h>
 
+#include "quadratic_landmark_factor.h"
 #include "solve_control_callback.h"
 #include "vio/estimator/window.h"
 
@@ -67,27 +70,43 @@ struct Window::IdOrderedCopy {
 };
 
 SolveReport Window::SolveSparse(const SolverOptions& options) {
+  const VariableIds variable = VariableIdsOf();
+  if (variable.states.empty() && variable.landmarks.empty()) return SolveReport();
+  const Leaving solved = SolvedOf(variable);
+  const std::vector<ceres::ResidualBlockId> residuals = ResidualOrderOf(solved);
+  return SolveCopy(options, residuals, {}, CopyOf(residuals, {}));
+}
+
+Window::Leaving Window::SolvedOf(const VariableIds& variable) {
+  Leaving solved = LeavingOf(variable.states, variable.landmarks);
+  if (estimates_time_offset() && !problem_->IsParameterBlockConstant(time_offset_)) {
+    solved.blocks.insert(time_offset_);  // and its prior
+  }
+  return solved;
+}
+
+Window::VariableIds Window::VariableIdsOf() const {
   const auto variable = [this](const double* block) { return !problem_->IsParameterBlockConstant(block); };
-  std::vector<StateId> state_ids;
-  std::vector<LandmarkId> landmark_ids;
+  VariableIds ids;
   for (const auto& [id, s] : states_) {
-    if (variable(s.pose) || variable(s.speed_bias)) state_ids.push_back(id);
+    if (variable(s.pose) || variable(s.speed_bias)) ids.states.push_back(id);
   }
   for (const auto& [id, landmark] : landmarks_) {
-    if (variable(landmark.p_w)) landmark_ids.push_back(id);
+    if (variable(landmark.p_w)) ids.landmarks.push_back(id);
   }
-  if (state_ids.empty() && landmark_ids.empty()) return SolveReport();
-  Leaving solved = LeavingOf(state_ids, landmark_ids);
-  if (estimates_time_offset() && variable(time_offset_)) solved.blocks.insert(time_offset_);  // and its prior
-  const std::vector<ceres::ResidualBlockId> residuals = ResidualOrderOf(solved);
+  return ids;
+}
 
-  // Every block the residuals touch, states (pose, speed/bias) then landmarks, by id.
+// Every block the residuals and `extra` touch, states (pose, speed/bias) then landmarks, by id.
+Window::IdOrderedCopy Window::CopyOf(const std::vector<ceres::ResidualBlockId>& residuals,
+                                     const LandmarkFactors& extra) const {
   std::unordered_map<const double*, int> touched;
   for (ceres::ResidualBlockId residual : residuals) {
     std::vector<double*> blocks;
     problem_->GetParameterBlocksForResidualBlock(residual, &blocks);
     for (const double* block : blocks) touched.emplace(block, 0);
   }
+  for (const auto& [block, factor] : extra) touched.emplace(block, 0);
   IdOrderedCopy copy;
   std::vector<size_t> offsets;
   const auto take = [&](const double* block) {
@@ -104,7 +123,43 @@ SolveReport Window::SolveSparse(const SolverOptions& options) {
   take(time_offset_);  // when estimated
   CHECK_EQ(copy.blocks.size(), touched.size()) << "a residual touches a block that is no state, landmark or calibration";
   for (size_t k = 0; k < copy.blocks.size(); ++k) copy.copy_of[copy.blocks[k]] = copy.values.data() + offsets[k];
-  return SolveCopy(options, residuals, copy);
+  return copy;
+}
+
+// The observations from constant states drop out: their landmarks get one
+// quadratic factor each instead (QuadraticLandmarkFactor).
+SolveReport Window::SolveSparse(const SolverOptions& options, const FrozenObservations& frozen) {
+  const VariableIds variable = VariableIdsOf();
+  if (variable.states.empty() && variable.landmarks.empty()) return SolveReport();
+  const Leaving solved = SolvedOf(variable);
+  std::vector<std::unique_ptr<ceres::CostFunction>> factors;
+  LandmarkFactors extra;
+  for (LandmarkId id : variable.landmarks) {
+    const auto it = frozen.landmarks.find(id);
+    if (it == frozen.landmarks.end()) continue;
+    factors.push_back(QuadraticLandmarkFactor(it->second));
+    extra.emplace_back(landmarks_.at(id).p_w, factors.back().get());
+  }
+  const std::vector<ceres::ResidualBlockId> residuals = RecentResidualOrderOf(solved);
+  return SolveCopy(options, residuals, extra, CopyOf(residuals, extra));
+}
+
+std::vector<ceres::ResidualBlockId> Window::RecentResidualOrderOf(const Leaving& solved) const {
+  std::vector<ceres::ResidualBlockId> order;
+  for (const Prior& prior : priors_) {
+    if (Touches(prior, solved)) order.push_back(prior.residual);
+  }
+  for (const auto& [to, edge] : imu_edges_) {
+    if (Touches(to, edge, solved)) order.push_back(edge.residual);
+  }
+  for (StateId id : solved.states) {
+    for (auto it = observations_.lower_bound({id, LandmarkId(std::numeric_limits<std::int64_t>::min())});
+         it != observations_.end() && it->first.first == id; ++it) {
+      order.push_back(it->second.residual);
+    }
+  }
+  for (const ObservationKey& key : AnchoredKeysOf(solved)) order.push_back(anchored_points_.at(key));
+  return order;
 }
 
 // The elimination group (0 first) of every state and landmark block.
@@ -141,7 +196,7 @@ std::unordered_map<const double*, int> Window::EliminationGroups(const std::stri
 
 // LM on the copy.
 SolveReport Window::SolveCopy(const SolverOptions& options, const std::vector<ceres::ResidualBlockId>& residuals,
-                              const IdOrderedCopy& ids) {
+                              const LandmarkFactors& extra, const IdOrderedCopy& ids) {
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -165,6 +220,7 @@ SolveReport Window::SolveCopy(const SolverOptions& options, const std::vector<ce
                           const_cast<ceres::LossFunction*>(problem_->GetLossFunctionForResidualBlock(residual)),
                           window_blocks);
   }
+  for (const auto& [block, factor] : extra) copy.AddResidualBlock(factor, nullptr, ids.copy_of.at(block));
   ceres::Solver::Options solver = LinearSolverOptions(options, ordering);
   SolveControlCallback control(solve_control_, solver.max_num_iterations);
   solver.callbacks.push_back(&control);

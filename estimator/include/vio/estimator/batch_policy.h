@@ -3,13 +3,17 @@
 // marginalization. Every state and landmark stays; a landmark seen again is
 // the same variable. While the data streams in, the recent states are solved
 // every few frames with the states older than the window (and landmarks only
-// they see) held constant; after the last frame everything is freed and
+// they see) held constant, the frozen states' observations summarized per
+// landmark (frozen_observations.h); after the last frame everything is freed and
 // solved together (SolveWhole: sparse Cholesky of the whole system, segments
 // of states with the landmarks only they see eliminated first, on a copy laid
 // out by id): the offline reference and the accuracy floor of the online
 // policies.
+#include <cstdint>
+#include <limits>
 #include <set>
 
+#include "vio/estimator/frozen_observations.h"
 #include "vio/estimator/policy.h"
 
 namespace vio {
@@ -27,6 +31,8 @@ class BatchPolicy final : public Policy {
 
   EstimatorOptions options_;
   std::set<StateId> active_;  ///< states not yet frozen, oldest first
+  StateId refresh_from_{std::numeric_limits<std::int64_t>::min()};  ///< IMU factors into it and later: checked
+  FrozenObservations frozen_;  ///< the frozen states' observations, for the periodic solves
   int frames_ = 0;
 };
 

@@ -10,6 +10,7 @@
 //             Drop*(): remove without keeping their information.
 // Policies (policy.h) are functions over a Window.
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -22,6 +23,7 @@
 
 #include "vio/estimator/estimator_options.h"
 #include "vio/estimator/first_estimates.h"
+#include "vio/estimator/frozen_observations.h"
 #include "vio/estimator/gauss_newton.h"
 #include "vio/estimator/imu_preintegration.h"
 #include "vio/estimator/solve_control.h"
@@ -159,8 +161,17 @@ class Window {
   /// sparse Cholesky, segments of states and the landmarks only they see first (EliminationGroups).
   /// Depends only on the values, not on the heap layout (batch's solves; window_sparse_solve.cc).
   SolveReport SolveSparse(const SolverOptions& options);
-  /// Re-preintegrates IMU factors whose gyro-bias linearization moved too far.
-  int RefreshImuFactors(double gyro_bias_threshold);
+  /// SolveSparse with the observations from constant states replaced by their summaries in
+  /// `frozen` (frozen_observations.h): batch's periodic solves. Every constant state's
+  /// observations must be in `frozen`.
+  SolveReport SolveSparse(const SolverOptions& options, const FrozenObservations& frozen);
+  /// Adds the observations of `state` at the current values to `frozen`, before the state is
+  /// held constant for good; the landmarks they see must be variable.
+  void SummarizeObservationsOf(StateId state, FrozenObservations& frozen) const;
+  /// Re-preintegrates IMU factors whose gyro-bias linearization moved too far; only those into
+  /// `first_to` and later states (batch: the others start at states frozen since they were checked).
+  int RefreshImuFactors(double gyro_bias_threshold,
+                        StateId first_to = StateId(std::numeric_limits<std::int64_t>::min()));
   /// J^T J of the whole cost at the current values over the tangent spaces of the states'
   /// [pose, speed_bias] and the landmarks, in that order, every other block held: the information
   /// of one Gauss-Newton step (after Marginalize: of the priors); its inverse is the covariance.
@@ -260,9 +271,22 @@ class Window {
   SolveReport GaussNewton(int max_steps, bool until_converged, const SolverOptions& options);
   SolveReport LevenbergMarquardt(const ceres::Solver::Options& base, const SolverOptions& options);
   struct IdOrderedCopy;
+  /// Factors of the copy beyond the window's residuals, each on one landmark block (the caller owns them).
+  using LandmarkFactors = std::vector<std::pair<const double*, ceres::CostFunction*>>;
+  struct VariableIds {
+    std::vector<StateId> states;
+    std::vector<LandmarkId> landmarks;
+  };
+  VariableIds VariableIdsOf() const;
+  /// The variable blocks' Leaving, with the time offset when it is estimated and variable.
+  Leaving SolvedOf(const VariableIds& variable);
+  IdOrderedCopy CopyOf(const std::vector<ceres::ResidualBlockId>& residuals, const LandmarkFactors& extra) const;
   std::unordered_map<const double*, int> EliminationGroups(const std::string& linear_solver) const;
   SolveReport SolveCopy(const SolverOptions& options, const std::vector<ceres::ResidualBlockId>& residuals,
-                        const IdOrderedCopy& ids);
+                        const LandmarkFactors& extra, const IdOrderedCopy& ids);
+  /// The residuals SolveSparse(options, frozen) copies: those of the variable states (priors, IMU
+  /// factors, observations, anchored points) and the priors on the variable landmarks, in ResidualOrder().
+  std::vector<ceres::ResidualBlockId> RecentResidualOrderOf(const Leaving& solved) const;
   std::set<const double*> BlocksInPriors() const;
   /// Every residual block: priors in creation order, IMU factors and
   /// observations by ids (never by address).
