@@ -159,6 +159,9 @@ class Window {
   /// sparse Cholesky, segments of states and the landmarks only they see first (EliminationGroups).
   /// Depends only on the values, not on the heap layout (batch's solves; window_sparse_solve.cc).
   SolveReport SolveSparse(const SolverOptions& options);
+  /// Drops every observation that does not evaluate (finitely) at the current values, and a landmark
+  /// left unobserved that no prior holds (as a rejected step does): the number of observations dropped.
+  int DropUnevaluableObservations();
   /// Re-preintegrates IMU factors whose gyro-bias linearization moved too far.
   int RefreshImuFactors(double gyro_bias_threshold);
   /// J^T J of the whole cost at the current values over the tangent spaces of the states'
