@@ -83,6 +83,9 @@ RefinementReport Refine(const MeasurementLog& log, const StartValue& start, cons
   RefinementReport report;
   report.ran = true;
   Build(log, start, options, whole);
+  // An observation that does not evaluate at the start values (a landmark at or behind a camera)
+  // would fail the whole solve before its first iteration: dropped first, as a window's solve does.
+  report.dropped_observations = whole.DropUnevaluableObservations();
   report.states = static_cast<int>(whole.states().size());
   report.landmarks = static_cast<int>(whole.landmarks().size());
   if (report.states > 0) {
@@ -95,7 +98,8 @@ RefinementReport Refine(const MeasurementLog& log, const StartValue& start, cons
     if (whole.estimates_time_offset()) report.time_offset_s = whole.time_offset_s();
   }
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-  LOG(INFO) << "refinement: " << report.states << " states, " << report.landmarks << " landmarks, "
+  LOG(INFO) << "refinement: " << report.states << " states, " << report.landmarks << " landmarks ("
+            << report.dropped_observations << " observations dropped), "
             << report.iterations << " iterations, cost " << report.initial_cost << " -> " << report.final_cost
             << ", " << report.seconds << " s";
   return report;

@@ -356,6 +356,12 @@ std::vector<Window::ObservationKey> Window::UnevaluableObservations() const {
   return failing;
 }
 
+int Window::DropUnevaluableObservations() {
+  const std::vector<ObservationKey> failing = UnevaluableObservations();
+  DropOutlierObservations(failing);
+  return static_cast<int>(failing.size());
+}
+
 void Window::DropOutlierObservations(const std::vector<ObservationKey>& observations) {
   const std::set<const double*> held = BlocksInPriors();
   for (const auto& [state_id, landmark_id] : observations) {

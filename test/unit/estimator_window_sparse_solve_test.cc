@@ -136,5 +136,41 @@ TEST(Refinement, SolvesTheLoggedFramesToTheDirectSolve) {
   EXPECT_LT(MaxDifference(AllValues(whole), AllValues(direct)), 1e-6);
 }
 
+// A start value that puts landmarks behind a camera (one state turned about
+// half a turn): its observations do not evaluate there, and would fail the
+// whole solve before its first iteration; they are dropped and the rest refines.
+TEST(Refinement, DropsObservationsThatDoNotEvaluateAtTheStart) {
+  EstimatorOptions options;
+  MeasurementLog log;
+  StatePrior prior;
+  prior.pose_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e-6;
+  prior.speed_bias_sigma << Eigen::Vector3d::Constant(0.1), Eigen::Vector3d::Constant(0.01),
+      Eigen::Vector3d::Constant(0.1);
+  log.first_prior = prior;
+  Window direct(options.model, Flight().stereo());
+  Flight().Build(direct, options.model, kFirst, kFrames, kOffsetM);
+  for (int k = 0; k < kFrames; ++k) {
+    const StereoFrame& frame = Flight().frames()[kFirst + k];
+    LoggedState logged{StateId(k), frame.t_ns, frame.observations, std::nullopt};
+    if (k > 0) logged.imu = Flight().ImuBetween(kFirst + k - 1);
+    log.states.push_back(logged);
+  }
+  const Eigen::Vector3d optical_axis = Flight().stereo().T_b_cl.linear() * Eigen::Vector3d::UnitZ();
+  const Eigen::Quaterniond half_turn(Eigen::AngleAxisd(M_PI, optical_axis.unitOrthogonal()));
+  const StartValue start = [&direct, &half_turn](const LoggedState& logged, State* s) {
+    std::copy(direct.state(logged.id).pose, direct.state(logged.id).pose + 7, s->pose);
+    std::copy(direct.state(logged.id).speed_bias, direct.state(logged.id).speed_bias + 9, s->speed_bias);
+    if (logged.id.value == kFrames - 1) s->SetPose(s->p_w_b(), (s->q_w_b() * half_turn).normalized());
+    return true;
+  };
+  Window whole(options.model, Flight().stereo());
+  const RefinementReport report = Refine(log, start, options, whole);
+  EXPECT_GT(report.dropped_observations, 0);
+  EXPECT_LT(report.dropped_observations, static_cast<int>(log.states.back().observations.size()) + 1);
+  EXPECT_TRUE(report.usable);
+  EXPECT_GT(report.iterations, 0);
+  EXPECT_EQ(report.states, kFrames);
+}
+
 }  // namespace
 }  // namespace vio

@@ -50,6 +50,7 @@ std::string RefinementJson(const RefinementReport& r) {
   std::ostringstream out;
   out << "{\"seconds\": " << JsonNumber(r.seconds) << ", \"iterations\": " << r.iterations
       << ", \"states\": " << r.states << ", \"landmarks\": " << r.landmarks
+      << ", \"dropped_observations\": " << r.dropped_observations
       << ", \"initial_cost\": " << JsonNumber(r.initial_cost) << ", \"final_cost\": " << JsonNumber(r.final_cost)
       << ", \"usable\": " << (r.usable ? "true" : "false") << "}";
   return out.str();

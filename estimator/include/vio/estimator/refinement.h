@@ -50,6 +50,7 @@ struct RefinementReport {
   int iterations = 0;
   int states = 0;
   int landmarks = 0;
+  int dropped_observations = 0;  ///< observations that did not evaluate at the start values: dropped before the solve
   double initial_cost = 0;
   double final_cost = 0;
   bool usable = false;

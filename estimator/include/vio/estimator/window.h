@@ -161,6 +161,9 @@ class Window {
   /// sparse Cholesky, segments of states and the landmarks only they see first (EliminationGroups).
   /// Depends only on the values, not on the heap layout (batch's solves; window_sparse_solve.cc).
   SolveReport SolveSparse(const SolverOptions& options);
+  /// Drops every observation that does not evaluate (finitely) at the current values, and a landmark
+  /// left unobserved that no prior holds (as a rejected step does): the number of observations dropped.
+  int DropUnevaluableObservations();
   /// SolveSparse with the observations from constant states replaced by their summaries in
   /// `frozen` (frozen_observations.h): batch's periodic solves. Every constant state's
   /// observations must be in `frozen`.
