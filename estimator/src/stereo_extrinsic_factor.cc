@@ -1,0 +1,63 @@
+#include "vio/estimator/stereo_extrinsic_factor.h"
+
+#include <stdexcept>
+
+#include "vio/estimator/so3.h"
+
+namespace vio {
+
+RectifiedStereo CorrectedStereo(const RectifiedStereo& stereo, const Eigen::Matrix<double, 6, 1>& correction) {
+  RectifiedStereo corrected = stereo;
+  corrected.T_b_cl.linear() = stereo.T_b_cl.linear() * so3::Exp(correction.head<3>());
+  corrected.T_b_cl.translation() = stereo.T_b_cl.translation() + correction.tail<3>();
+  return corrected;
+}
+
+StereoExtrinsicFactor::StereoExtrinsicFactor(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo,
+                                             double sigma_px)
+    : z_px_(z_px), stereo_(stereo), sigma_px_(sigma_px) {
+  if (!(sigma_px > 0.0)) throw std::invalid_argument("StereoExtrinsicFactor: sigma_px must be > 0");
+}
+
+bool StereoExtrinsicFactor::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
+  return EvaluateImpl(parameters, residuals, jacobians, /*on_tangents=*/false);
+}
+
+bool StereoExtrinsicFactor::EvaluateOnTangents(double const* const* parameters, double* residuals,
+                                               double** jacobians) const {
+  return EvaluateImpl(parameters, residuals, jacobians, /*on_tangents=*/true);
+}
+
+bool StereoExtrinsicFactor::EvaluateImpl(double const* const* parameters, double* residuals, double** jacobians,
+                                         bool on_tangents) const {
+  const Eigen::Map<const Eigen::Matrix<double, 6, 1>> correction(parameters[2]);
+  const RectifiedStereo rig = CorrectedStereo(stereo_, correction);
+  const StereoFactor stereo(z_px_, rig, sigma_px_);
+  const bool want_extrinsic = jacobians != nullptr && jacobians[2] != nullptr;
+  // The landmark Jacobian J_l = -(1/sigma) dh/dp_c R_c_w gives -(1/sigma) dh/dp_c = J_l R_w_c.
+  Eigen::Matrix<double, 3, 3, Eigen::RowMajor> landmark_jacobian;
+  double* stereo_jacobians[2] = {nullptr, nullptr};
+  if (jacobians != nullptr) {
+    stereo_jacobians[0] = jacobians[0];
+    stereo_jacobians[1] = jacobians[1];
+    if (stereo_jacobians[1] == nullptr && want_extrinsic) stereo_jacobians[1] = landmark_jacobian.data();
+  }
+  double** inner = jacobians != nullptr ? stereo_jacobians : nullptr;
+  const bool ok = on_tangents ? stereo.EvaluateOnTangents(parameters, residuals, inner)
+                              : stereo.Evaluate(parameters, residuals, inner);
+  if (!ok || !want_extrinsic) return ok;
+  if (jacobians[1] != nullptr) landmark_jacobian = Eigen::Map<const decltype(landmark_jacobian)>(jacobians[1]);
+  const Eigen::Quaterniond q_w_b(parameters[0][6], parameters[0][3], parameters[0][4], parameters[0][5]);
+  const Eigen::Matrix3d R_w_c = q_w_b.normalized().toRotationMatrix() * rig.T_b_cl.linear();
+  const Eigen::Vector3d p_w_l(parameters[1][0], parameters[1][1], parameters[1][2]);
+  const Eigen::Vector3d p_w_b(parameters[0][0], parameters[0][1], parameters[0][2]);
+  const Eigen::Vector3d p_c = R_w_c.transpose() * (p_w_l - p_w_b) -
+                              rig.T_b_cl.linear().transpose() * rig.T_b_cl.translation();
+  const Eigen::Matrix3d de_dpc = landmark_jacobian * R_w_c;
+  Eigen::Map<Eigen::Matrix<double, 3, 6, Eigen::RowMajor>> J(jacobians[2]);
+  J.leftCols<3>() = de_dpc * so3::Hat(p_c) * so3::RightJacobian(correction.head<3>());
+  J.rightCols<3>() = -de_dpc * rig.T_b_cl.linear().transpose();
+  return true;
+}
+
+}  // namespace vio
