@@ -38,25 +38,13 @@ Estimator::Estimator(const EstimatorOptions& options, const ImuCalibration& imu,
   }
 }
 
-namespace {
-
-// T_w_cl of a state: its pose and the rig's left camera.
-Eigen::Isometry3d CameraPose(const State& state, const RectifiedStereo& stereo) {
-  Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();
-  T_w_b.linear() = state.q_w_b().toRotationMatrix();
-  T_w_b.translation() = state.p_w_b();
-  return T_w_b * stereo.T_b_cl;
-}
-
-}  // namespace
-
 double Estimator::time_offset_s() const {
   return window_.estimates_time_offset() ? window_.time_offset_s() : 1e-3 * options_.model.time_offset_prior_mean_ms;
 }
 
 Timestamp Estimator::AppliedTimeOffsetNs() const { return SecondsToNanos(time_offset_s()); }
 
-std::map<LandmarkId, Eigen::Vector3d> Estimator::ImageVelocities(const StereoFrame& frame) {
+std::map<LandmarkId, Eigen::Vector3d> Estimator::ImageVelocities(const StereoFrame& frame) const {
   std::map<LandmarkId, Eigen::Vector3d> velocity;
   const State& s = window_.state(last_state_);
   // The bias-corrected gyro at the frame: the IMU sample nearest its time.
@@ -66,32 +54,10 @@ std::map<LandmarkId, Eigen::Vector3d> Estimator::ImageVelocities(const StereoFra
   auto nearest = after == imu_.end() ? std::prev(after) : after;
   if (nearest != imu_.begin() && s.t_ns - std::prev(nearest)->t_ns < nearest->t_ns - s.t_ns) nearest = std::prev(nearest);
   const Eigen::Vector3d omega_b = nearest->gyro_rad_s - s.gyro_bias();
-  const RectifiedStereo& stereo = window_.stereo();
-  const Eigen::Isometry3d T_cl_w = CameraPose(s, stereo).inverse();
-  std::map<LandmarkId, Eigen::Vector3d> points_c;
   for (const StereoObservation& obs : frame.observations) {
-    const std::optional<Eigen::Vector3d> measured =
-        TriangulateRectified(obs.z_px, stereo, options_.model.min_disparity_px);
-    if (measured) points_c.emplace(obs.landmark, *measured);
-    // The point must not come from this measurement: a velocity that shares its noise biases the offset.
-    std::optional<Eigen::Vector3d> earlier;
-    if (window_.HasLandmark(obs.landmark)) {
-      earlier = window_.landmark(obs.landmark).position();
-    } else if (const auto it = velocity_points_.points_c.find(obs.landmark);
-               it != velocity_points_.points_c.end() && window_.HasState(velocity_points_.state)) {
-      earlier = CameraPose(window_.state(velocity_points_.state), stereo) * it->second;
-    }
-    if (earlier) {
-      const Eigen::Vector3d p_c = T_cl_w * *earlier;
-      if (p_c.z() > 0.0 && p_c.z() <= options_.model.max_depth_m) {
-        velocity.emplace(obs.landmark, PointImageVelocity(p_c, stereo, s.q_w_b(), s.v_w_b(), omega_b));
-        continue;
-      }
-    }
-    velocity.emplace(obs.landmark, ImageVelocity(obs.z_px, stereo, s.q_w_b(), s.v_w_b(), omega_b,
+    velocity.emplace(obs.landmark, ImageVelocity(obs.z_px, window_.stereo(), s.q_w_b(), s.v_w_b(), omega_b,
                                                  options_.model.min_disparity_px, options_.model.max_depth_m));
   }
-  velocity_points_ = {last_state_, std::move(points_c)};
   return velocity;
 }
 

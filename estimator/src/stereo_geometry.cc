@@ -31,11 +31,6 @@ Eigen::Vector3d ImageVelocity(const Eigen::Vector3d& z_px, const RectifiedStereo
   } else {
     p_c = max_depth_m * Eigen::Vector3d((z_px[0] - stereo.cx) / stereo.f, (z_px[2] - stereo.cy) / stereo.f, 1.0);
   }
-  return PointImageVelocity(p_c, stereo, q_w_b, v_w_b, omega_b);
-}
-
-Eigen::Vector3d PointImageVelocity(const Eigen::Vector3d& p_c, const RectifiedStereo& stereo, const Eigen::Quaterniond& q_w_b,
-                                   const Eigen::Vector3d& v_w_b, const Eigen::Vector3d& omega_b) {
   const Eigen::Matrix3d R_b_c = stereo.T_b_cl.linear();
   const Eigen::Vector3d p_b = R_b_c * p_c + stereo.T_b_cl.translation();
   const Eigen::Vector3d dp_c = R_b_c.transpose() * (-omega_b.cross(p_b) - q_w_b.conjugate() * v_w_b);

@@ -164,11 +164,8 @@ class Estimator {
   void PruneImu(Timestamp before_ns);
   Timestamp AppliedTimeOffsetNs() const;
   /// The frame's image velocities [px/s] by landmark at the newest state's (IMU-predicted)
-  /// velocity and bias-corrected gyro rate, each at a point that does not share the frame's
-  /// measurement noise: the landmark's estimate in the window, else its stereo point of the frame
-  /// before (at that state's current estimate), else (its first frame) this measurement's (PointImageVelocity, ImageVelocity).
-  /// Keeps this frame's stereo points for the next.
-  std::map<LandmarkId, Eigen::Vector3d> ImageVelocities(const StereoFrame& frame);
+  /// velocity and bias-corrected gyro rate (ImageVelocity).
+  std::map<LandmarkId, Eigen::Vector3d> ImageVelocities(const StereoFrame& frame) const;
 
   EstimatorOptions options_;
   ImuCalibration imu_calibration_;
@@ -200,12 +197,6 @@ class Estimator {
   std::optional<TimeOffsetSearchReport> time_offset_search_;  ///< its result, once decided
   int implausible_inits_ = 0;                   ///< dynamic initializations in a row that were implausible
   std::string input_problem_;
-  /// The last frame's stereo points [m, its left camera] by landmark (ImageVelocities).
-  struct VelocityPoints {
-    StateId state;
-    std::map<LandmarkId, Eigen::Vector3d> points_c;
-  };
-  VelocityPoints velocity_points_;
   std::optional<MeasurementLog> log_;  ///< with KeepMeasurements: every state's measurements
 };
 

@@ -25,8 +25,4 @@ Eigen::Vector3d ImageVelocity(const Eigen::Vector3d& z_px, const RectifiedStereo
                               const Eigen::Vector3d& v_w_b, const Eigen::Vector3d& omega_b, double min_disparity_px,
                               double max_depth_m);
 
-/// The same for a point p_c [m] in the rectified left camera (z > 0).
-Eigen::Vector3d PointImageVelocity(const Eigen::Vector3d& p_c, const RectifiedStereo& stereo, const Eigen::Quaterniond& q_w_b,
-                                   const Eigen::Vector3d& v_w_b, const Eigen::Vector3d& omega_b);
-
 }  // namespace vio
