@@ -2,8 +2,10 @@
 // exactly the asked offset and rigid error, IMU and ground truth untouched, the stereo baseline kept.
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include "test_data.h"
 #include "vio/dataset/euroc_dataset.h"
@@ -57,6 +59,19 @@ TEST(SimulatorRigErrorsTest, WritesShiftedStampsAndMovedRig) {
     EXPECT_NEAR((moved.matrix() - E.matrix()).norm(), 0.0, 1e-6);
   }
   EXPECT_NEAR(E.translation().norm(), 0.015, 1e-12);
+  // The truth a calibration is compared with: E and the offset, read back.
+  const YAML::Node truth = YAML::LoadFile(base + "/rig/mav0/rig_truth.yaml");
+  EXPECT_DOUBLE_EQ(truth["time_offset_ms"].as<double>(), 15.0);
+  EXPECT_NEAR(truth["extrinsic_rotation_deg"].as<double>(), 1.0, 1e-9);
+  const auto axis = truth["extrinsic_rotation_axis"].as<std::vector<double>>();
+  const auto t = truth["extrinsic_translation_m"].as<std::vector<double>>();
+  ASSERT_EQ(axis.size(), 3u);
+  ASSERT_EQ(t.size(), 3u);
+  const Eigen::Matrix3d R_truth(Eigen::AngleAxisd(1.0 * M_PI / 180.0, Eigen::Vector3d(axis[0], axis[1], axis[2])));
+  EXPECT_NEAR((R_truth - E.linear()).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((Eigen::Vector3d(t[0], t[1], t[2]) - E.translation()).norm(), 0.0, 1e-15);
+  EXPECT_DOUBLE_EQ(YAML::LoadFile(base + "/clean/mav0/rig_truth.yaml")["time_offset_ms"].as<double>(), 0.0);
+
   const Eigen::Isometry3d baseline_clean = clean.cameras[0].T_b_c.inverse() * clean.cameras[1].T_b_c;
   const Eigen::Isometry3d baseline_rig = rig.cameras[0].T_b_c.inverse() * rig.cameras[1].T_b_c;
   EXPECT_NEAR((baseline_clean.matrix() - baseline_rig.matrix()).norm(), 0.0, 1e-6);

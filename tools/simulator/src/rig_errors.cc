@@ -1,6 +1,7 @@
 #include "vio/simulator/rig_errors.h"
 
 #include <cmath>
+#include <fstream>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -63,6 +64,22 @@ void ApplyRigErrors(const RigErrorOptions& options, std::uint64_t seed, EurocDat
   if (options.extrinsic_error_deg == 0.0 && options.extrinsic_error_m == 0.0) return;
   const Eigen::Isometry3d E = ExtrinsicError(options, seed);
   for (CameraCalibration& camera : dataset->cameras) camera.T_b_c = E * camera.T_b_c;
+}
+
+void WriteRigTruth(const RigErrorOptions& options, std::uint64_t seed, const std::string& path) {
+  const Eigen::Isometry3d E = ExtrinsicError(options, seed);
+  const Eigen::AngleAxisd rotation(E.linear());
+  const Eigen::Vector3d axis = rotation.angle() > 0.0 ? rotation.axis() : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d t = E.translation();
+  std::ofstream out(path);
+  out.precision(17);
+  out << "# vio simulate: the rig errors this dataset was written with, the truth for an estimated calibration\n"
+      << "time_offset_ms: " << options.time_offset_ms << "  # an image stamped t was taken at IMU time t - offset\n"
+      << "# T_b_c in sensor.yaml = E * T_b_c true; E's rotation and translation (body frame)\n"
+      << "extrinsic_rotation_deg: " << rotation.angle() * 180.0 / kPi << "\n"
+      << "extrinsic_rotation_axis: [" << axis.x() << ", " << axis.y() << ", " << axis.z() << "]\n"
+      << "extrinsic_translation_m: [" << t.x() << ", " << t.y() << ", " << t.z() << "]\n";
+  if (!out) throw std::runtime_error(path + ": cannot write");
 }
 
 }  // namespace vio::tools

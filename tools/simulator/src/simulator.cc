@@ -329,6 +329,7 @@ void WriteSimulation(const Simulation& simulation, const SimulatorOptions& optio
                      const RenderProgress& progress) {
   if (options.output_dir.empty()) throw std::invalid_argument("simulator: an output folder is required");
   WriteSceneCsv({simulation.scene.room, simulation.scene.boxes}, options.output_dir + "/mav0/scene.csv");
+  WriteRigTruth(options.rig, options.seed, options.output_dir + "/mav0/rig_truth.yaml");
   if (!options.faults.any() && !options.rig.any()) {
     WriteEuroc(simulation.dataset, options.output_dir);
     if (options.camera_output == SimCameraOutput::kImages) WriteImages(simulation, options, progress);

@@ -48,27 +48,91 @@ std::string FixedOrDash(double value, int digits) {
   return text;
 }
 
-// The per-frame run-mean pose NEES of frames every run has, and the share within bounds.
-void NeesOverTime(const std::vector<const SweepResult*>& runs, MonteCarloSummary* summary) {
-  std::map<Timestamp, std::pair<double, int>> sums;
-  for (const SweepResult* r : runs) {
-    for (const auto& [t_ns, nees] : ReadPoseNees(r->run.run_dir + "/nees.csv")) {
-      sums[t_ns].first += nees;
-      ++sums[t_ns].second;
-    }
+// A run's frame matching time t_ns: the nearest within kSameFrameNs, or none. Each run's states are at
+// the IMU time of its own time offset estimate: the same frame differs between runs by their estimates.
+constexpr Timestamp kSameFrameNs = 5'000'000;
+
+const double* FrameNear(const std::map<Timestamp, double>& nees, Timestamp t_ns) {
+  auto after = nees.lower_bound(t_ns);
+  const double* best = nullptr;
+  Timestamp best_gap = kSameFrameNs + 1;
+  if (after != nees.end() && after->first - t_ns < best_gap) {
+    best_gap = after->first - t_ns;
+    best = &after->second;
   }
+  if (after != nees.begin() && t_ns - std::prev(after)->first < best_gap) best = &std::prev(after)->second;
+  return best;
+}
+
+// The per-frame run-mean pose NEES of frames every run has (the first run's times), and the share within
+// bounds.
+void NeesOverTime(const std::vector<const SweepResult*>& runs, MonteCarloSummary* summary) {
+  std::vector<std::map<Timestamp, double>> per_run;
+  for (const SweepResult* r : runs) per_run.push_back(ReadPoseNees(r->run.run_dir + "/nees.csv"));
+  if (per_run.empty()) return;
   int in_bounds = 0;
   Timestamp first = -1;
-  for (const auto& [t_ns, sum] : sums) {
-    if (sum.second != summary->runs) continue;
+  for (const auto& [t_ns, nees] : per_run.front()) {
+    double sum = nees;
+    bool everyone = true;
+    for (size_t k = 1; k < per_run.size() && everyone; ++k) {
+      const double* other = FrameNear(per_run[k], t_ns);
+      everyone = other != nullptr;
+      if (other) sum += *other;
+    }
+    if (!everyone) continue;
     if (first < 0) first = t_ns;
-    const double mean = sum.first / summary->runs;
+    const double mean = sum / summary->runs;
     summary->nees_over_time.emplace_back(NanosToSeconds(t_ns - first), mean);
     in_bounds += mean >= summary->lower_pose && mean <= summary->upper_pose;
   }
   if (!summary->nees_over_time.empty()) {
     summary->fraction_in_bounds = static_cast<double>(in_bounds) / summary->nees_over_time.size();
   }
+}
+
+// The time offset's error and NEES over the runs with an estimate, a sigma and a true offset.
+void TimeOffsetConsistency(const std::vector<const SweepResult*>& runs, MonteCarloSummary* summary) {
+  std::vector<const SweepResult*> with_truth;
+  for (const SweepResult* r : runs) {
+    if (std::isfinite(r->time_offset_ms) && std::isfinite(r->true_time_offset_ms) &&
+        std::isfinite(r->time_offset_sigma_ms) && r->time_offset_sigma_ms > 0) {
+      with_truth.push_back(r);
+    }
+  }
+  summary->offset_runs = static_cast<int>(with_truth.size());
+  if (with_truth.empty()) return;
+  const double n = static_cast<double>(with_truth.size());
+  double squares = 0;
+  for (const SweepResult* r : with_truth) {
+    const double error = r->time_offset_ms - r->true_time_offset_ms;
+    summary->offset_mean_error_ms += error / n;
+    squares += error * error / n;
+    summary->offset_mean_sigma_ms += r->time_offset_sigma_ms / n;
+    summary->anees_time_offset += (error / r->time_offset_sigma_ms) * (error / r->time_offset_sigma_ms) / n;
+  }
+  summary->offset_rms_error_ms = std::sqrt(squares);
+  const ChiSquareBounds bounds = AneesBounds95(1, summary->offset_runs);
+  summary->lower_time_offset = bounds.lower;
+  summary->upper_time_offset = bounds.upper;
+}
+
+std::string TimeOffsetMarkdown(const std::vector<MonteCarloSummary>& summaries) {
+  std::string md =
+      "\nThe camera-IMU time offset's final estimate against the simulated one (mav0/rig_truth.yaml), one per run; "
+      "NEES = (error / sigma)^2, 1 dof:\n\n"
+      "| policy | window | runs | mean error [ms] | RMS error [ms] | mean sigma [ms] | NEES (1) | 95% bounds |\n"
+      "|---|---:|---:|---:|---:|---:|---:|---|\n";
+  bool any = false;
+  for (const MonteCarloSummary& s : summaries) {
+    if (s.offset_runs == 0) continue;
+    any = true;
+    md += "| " + s.policy + " | " + std::to_string(s.window_size) + " | " + std::to_string(s.offset_runs) + " | " +
+          FixedOrDash(s.offset_mean_error_ms, 3) + " | " + FixedOrDash(s.offset_rms_error_ms, 3) + " | " +
+          FixedOrDash(s.offset_mean_sigma_ms, 3) + " | " + FixedOrDash(s.anees_time_offset, 2) + " | [" +
+          FixedOrDash(s.lower_time_offset, 2) + ", " + FixedOrDash(s.upper_time_offset, 2) + "] |\n";
+  }
+  return any ? md : "";
 }
 
 }  // namespace
@@ -125,6 +189,7 @@ std::vector<MonteCarloSummary> SummarizeMonteCarlo(const std::vector<SweepResult
     s.lower_pose = bounds.lower;
     s.upper_pose = bounds.upper;
     NeesOverTime(runs, &s);
+    TimeOffsetConsistency(runs, &s);
   }
   return summaries;
 }
@@ -141,7 +206,7 @@ std::string MonteCarloMarkdown(const std::vector<MonteCarloSummary>& summaries) 
           (s.runs ? FixedOrDash(s.anees_position, 2) : "-") + " | " + (s.runs ? FixedOrDash(s.anees_orientation, 2) : "-") +
           " |\n";
   }
-  return md;
+  return md + TimeOffsetMarkdown(summaries);
 }
 
 }  // namespace vio::tools

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <yaml-cpp/yaml.h>
+
 #include "internal.h"
 #include "json.h"
 #include "vio/evaluation/nees.h"
@@ -61,10 +63,26 @@ void ReadSummary(const std::string& path, SweepResult* result) {
   result->peak_memory_mb = NumberOf(summary, "peak_memory_mb");
   if (const JsonValue* reason = summary.Find("not_initialized_reason")) result->message = reason->string;
   if (const JsonValue* evaluation = summary.Find("evaluation")) ReadEvaluation(*evaluation, result);
+  if (const JsonValue* calibration = summary.Find("calibration")) {
+    result->time_offset_ms = NumberOf(*calibration, "time_offset_ms");
+    result->time_offset_sigma_ms = NumberOf(*calibration, "time_offset_sigma_ms");
+  }
   if (const JsonValue* nees = summary.Find("nees")) {
     result->nees_pose = NumberOf(*nees, "pose");
     result->nees_position = NumberOf(*nees, "position");
     result->nees_orientation = NumberOf(*nees, "orientation");
+  }
+}
+
+// time_offset_ms of a dataset's rig_truth.yaml (vio simulate); NaN without the file.
+double ReadTrueTimeOffset(const std::string& path) {
+  if (!fs::exists(path)) return SweepResult::kNaN;
+  try {
+    const YAML::Node truth = YAML::LoadFile(path);
+    if (!truth["time_offset_ms"]) throw std::runtime_error("no time_offset_ms");
+    return truth["time_offset_ms"].as<double>();
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": " + e.what());
   }
 }
 
@@ -137,6 +155,7 @@ SweepResult ReadRunResult(const SweepRun& run) {
   try {
     result.exit_code = ReadMarker(run.run_dir + "/done");
     ReadSummary(run.run_dir + "/summary.json", &result);
+    result.true_time_offset_ms = ReadTrueTimeOffset(run.dataset_dir + "/mav0/rig_truth.yaml");
   } catch (const std::exception& e) {
     result.status = "failed";
     result.message = e.what();

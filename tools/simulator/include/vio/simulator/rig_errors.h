@@ -11,6 +11,7 @@
 //    extrinsic_error_m along a direction (the stereo baseline is kept).
 #include <cstdint>
 #include <optional>
+#include <string>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -41,5 +42,11 @@ Eigen::Isometry3d ExtrinsicError(const RigErrorOptions& options, std::uint64_t s
 /// Applies the errors to a dataset about to be written: camera and feature stamps shifted, both
 /// cameras' T_b_c moved by ExtrinsicError. IMU and ground truth (the IMU clock) are untouched.
 void ApplyRigErrors(const RigErrorOptions& options, std::uint64_t seed, EurocDataset* dataset);
+
+/// Writes the errors as the truth an estimated calibration is compared with (`vio sweep` reads it):
+/// YAML `time_offset_ms` (the estimator's convention) and the written rig's error E
+/// (`extrinsic_rotation_deg`, `extrinsic_rotation_axis`, `extrinsic_translation_m` [x, y, z]); zeros for
+/// a right rig. Throws std::runtime_error when the file cannot be written.
+void WriteRigTruth(const RigErrorOptions& options, std::uint64_t seed, const std::string& path);
 
 }  // namespace vio::tools

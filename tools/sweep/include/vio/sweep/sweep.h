@@ -102,6 +102,9 @@ struct SweepResult {
   double nees_pose = kNaN;         ///< mean pose NEES over the run's frames (6 dof)
   double nees_position = kNaN;     ///< mean position NEES (3 dof)
   double nees_orientation = kNaN;  ///< mean orientation NEES (3 dof)
+  double time_offset_ms = kNaN;        ///< summary.json's calibration.time_offset_ms [ms]
+  double time_offset_sigma_ms = kNaN;  ///< its sigma, when the run estimated it [ms]
+  double true_time_offset_ms = kNaN;   ///< the dataset's mav0/rig_truth.yaml (vio simulate), when it has one [ms]
   bool Ok() const { return status == "ok"; }
 };
 
@@ -176,12 +179,22 @@ struct MonteCarloSummary {
   double fraction_in_bounds = 0;   ///< frames seen by every run whose run-mean pose NEES is within the bounds
   /// Per frame seen by every run: time from the first such frame [s] and the run-mean pose NEES.
   std::vector<std::pair<double, double>> nees_over_time;
+  /// The estimated camera-IMU time offset against the dataset's truth, over the ok runs that have an
+  /// estimate, its sigma and a true offset (final estimates, one per run).
+  int offset_runs = 0;
+  double offset_mean_error_ms = 0;  ///< mean of estimate - truth [ms]
+  double offset_rms_error_ms = 0;   ///< [ms]
+  double offset_mean_sigma_ms = 0;  ///< [ms]
+  double anees_time_offset = 0;     ///< mean of ((estimate - truth) / sigma)^2 (1 dof)
+  double lower_time_offset = 0;     ///< 95% bounds of that mean over offset_runs runs, chi2(N)/N
+  double upper_time_offset = 0;
 };
 
 /// Groups the results by (policy, window) and reads each ok run's nees.csv.
 std::vector<MonteCarloSummary> SummarizeMonteCarlo(const std::vector<SweepResult>& results);
 
-/// The Markdown table of SummarizeMonteCarlo.
+/// The Markdown table of SummarizeMonteCarlo, and a second one of the time offset when a
+/// configuration has runs with a true offset.
 std::string MonteCarloMarkdown(const std::vector<MonteCarloSummary>& summaries);
 
 /// Writes jobs.txt (one JobCommand per line, plan order); returns its path.
