@@ -47,6 +47,11 @@ void Window::SetCameraTiming(StateId id, double applied_offset_s, std::map<Landm
   camera_timing_[id] = CameraTiming{applied_offset_s, std::move(velocity_px_s)};
 }
 
+void Window::ReleaseImageVelocities(StateId id) {
+  const auto timing = camera_timing_.find(id);
+  if (timing != camera_timing_.end()) std::map<LandmarkId, Eigen::Vector3d>().swap(timing->second.velocity_px_s);
+}
+
 std::optional<double> Window::TimeOffsetSigma() {
   if (!estimates_time_offset() || problem_->IsParameterBlockConstant(time_offset_)) return std::nullopt;
   // The marginal comes from the dense reduced system over every variable state: a window's, or

@@ -129,6 +129,9 @@ class Window {
   /// The offset t_a [s] the state's time was made with (its camera stamp minus t_ns) and its
   /// observations' image velocities [px/s] by landmark: what its observations' factors use.
   void SetCameraTiming(StateId state, double applied_offset_s, std::map<LandmarkId, Eigen::Vector3d> velocity_px_s);
+  /// Frees the image velocities SetCameraTiming kept for `state` (its observations' factors hold
+  /// their own): for a policy that adds no further observation from `state` (batch).
+  void ReleaseImageVelocities(StateId state);
   /// The landmark measured in `anchor`'s body frame (AnchoredPointFactor, no loss): the local
   /// map's summary of the observations of frames it dropped. Replaces the pair's earlier one.
   void SetAnchoredPoint(StateId anchor, LandmarkId landmark, const Eigen::Vector3d& p_b_hat,
