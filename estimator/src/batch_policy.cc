@@ -44,10 +44,10 @@ void BatchPolicy::FreezeOld(Window& window) {
     active_.erase(active_.begin());
     window.SummarizeObservationsOf(oldest, frozen_);
     window.SetStateConstant(oldest, true);
-    // Frozen states keep their errors: fitted against them the offset would absorb those errors
-    // (synthetic flight: +2.5 ms on near-noiseless data), so it is held from the first freeze
-    // until the final solve.
-    if (window.estimates_time_offset()) window.SetTimeOffsetConstant(true);
+    // Frozen states keep their errors: fitted against them the calibration would absorb those
+    // errors (the time offset on a synthetic flight: +2.5 ms on near-noiseless data), so it is held
+    // from the first freeze until the final solve.
+    window.SetCalibrationConstant(true);
     for (const auto& [id, landmark] : window.landmarks()) {
       if (!landmark.observed_from.count(oldest)) continue;
       // The active states are the newest: the landmark's newest observer decides.
@@ -60,7 +60,7 @@ void BatchPolicy::FreezeOld(Window& window) {
 bool BatchPolicy::Finish(Window& window) {
   for (const auto& [id, state] : window.states()) window.SetStateConstant(id, false);
   for (const auto& [id, landmark] : window.landmarks()) window.SetLandmarkConstant(id, false);
-  if (window.estimates_time_offset()) window.SetTimeOffsetConstant(false);
+  window.SetCalibrationConstant(false);
   if (frozen_.skipped > 0) {
     LOG(WARNING) << "batch: " << frozen_.skipped << " observations did not evaluate when their state froze and were "
                  << "left out of the periodic solves";

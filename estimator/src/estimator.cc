@@ -26,15 +26,24 @@ Estimator::Estimator(const EstimatorOptions& options, const ImuCalibration& imu,
   imu_calibration_.accel_noise_density *= options.model.imu_noise_scale;
   imu_calibration_.gyro_random_walk *= options.model.imu_noise_scale;
   imu_calibration_.accel_random_walk *= options.model.imu_noise_scale;
-  if (options.model.estimate_time_offset && options.local_map.local_map_keyframes > 0) {
+  EstimateCalibration();
+}
+
+void Estimator::EstimateCalibration() {
+  const ModelOptions& model = options_.model;
+  if ((model.estimate_time_offset || model.estimate_extrinsics) && options_.local_map.local_map_keyframes > 0) {
     // Parked keyframes leave the cost with their priors (Window::RemoveState): not measured with
-    // the offset in those priors, so the local map keeps the prior mean as exact.
-    LOG(WARNING) << "estimate_time_offset is not available with local_map_keyframes > 0: the time offset is "
-                    "taken as time_offset_prior_mean_ms";
-  } else if (options.model.estimate_time_offset) {
-    window_.EstimateTimeOffset(1e-3 * options.model.time_offset_prior_mean_ms,
-                               1e-3 * options.model.time_offset_prior_sigma_ms);
+    // the calibration in those priors, so the local map keeps the sensor.yaml rig and the prior mean as exact.
+    LOG(WARNING) << "estimate_time_offset and estimate_extrinsics are not available with local_map_keyframes > 0: "
+                    "the time offset is taken as time_offset_prior_mean_ms and the extrinsics as given";
+    return;
+  }
+  if (model.estimate_time_offset) {
+    window_.EstimateTimeOffset(1e-3 * model.time_offset_prior_mean_ms, 1e-3 * model.time_offset_prior_sigma_ms);
     StartTimeOffsetSearch();
+  }
+  if (model.estimate_extrinsics) {
+    window_.EstimateExtrinsics(model.extrinsics_prior_sigma_deg * M_PI / 180.0, model.extrinsics_prior_sigma_m);
   }
 }
 
@@ -55,7 +64,7 @@ std::map<LandmarkId, Eigen::Vector3d> Estimator::ImageVelocities(const StereoFra
   if (nearest != imu_.begin() && s.t_ns - std::prev(nearest)->t_ns < nearest->t_ns - s.t_ns) nearest = std::prev(nearest);
   const Eigen::Vector3d omega_b = nearest->gyro_rad_s - s.gyro_bias();
   for (const StereoObservation& obs : frame.observations) {
-    velocity.emplace(obs.landmark, ImageVelocity(obs.z_px, window_.stereo(), s.q_w_b(), s.v_w_b(), omega_b,
+    velocity.emplace(obs.landmark, ImageVelocity(obs.z_px, window_.estimated_stereo(), s.q_w_b(), s.v_w_b(), omega_b,
                                                  options_.model.min_disparity_px, options_.model.max_depth_m));
   }
   return velocity;
@@ -342,7 +351,7 @@ std::vector<FrameEstimate> Estimator::Refine(RefinementReport* report) const {
     s->SetSpeedBias(it->second.v_w_b, it->second.gyro_bias, it->second.accel_bias);
     return true;
   };
-  Window whole(options_.model, window_.stereo());
+  Window whole(options_.model, window_.estimated_stereo());
   whole.SetSolveControl(window_.solve_control());
   *report = vio::Refine(*log_, start, options_, whole);
   if (!report->usable) return refined;

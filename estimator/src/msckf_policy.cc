@@ -282,7 +282,7 @@ std::vector<LandmarkId> MsckfPolicy::AddTriangulated(const std::vector<TrackUpda
   for (const TrackUpdate& update : updates) {
     std::vector<StereoView> views;
     for (const auto& [state, z] : update.observations) views.push_back({BodyPose(window.state(state)), z});
-    results.push_back(TriangulateMultiView(views, window.stereo(), triangulation));
+    results.push_back(TriangulateMultiView(views, window.estimated_stereo(), triangulation));
   }
   const double gate = ReprojectionGate(results);
   std::vector<LandmarkId> added;

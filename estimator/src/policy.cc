@@ -27,13 +27,13 @@ int AddStereoObservations(const StereoFrame& frame, StateId state_id, const Mode
                           int max_landmarks) {
   const State& s = window.state(state_id);
   const Eigen::Isometry3d T_w_b = Eigen::Translation3d(s.p_w_b()) * s.q_w_b();
-  const Eigen::Isometry3d T_w_cl = T_w_b * window.stereo().T_b_cl;
+  const Eigen::Isometry3d T_w_cl = T_w_b * window.estimated_stereo().T_b_cl;
   int added = 0;
   for (const StereoObservation& obs : frame.observations) {
     if (!window.HasLandmark(obs.landmark)) {
       if (max_landmarks > 0 && static_cast<int>(window.landmarks().size()) >= max_landmarks) continue;
       const std::optional<Eigen::Vector3d> p_cl =
-          TriangulateRectified(obs.z_px, window.stereo(), model.min_disparity_px);
+          TriangulateRectified(obs.z_px, window.estimated_stereo(), model.min_disparity_px);
       if (!p_cl || p_cl->z() > model.max_depth_m) continue;
       window.AddLandmark(obs.landmark, T_w_cl * *p_cl);
       ++added;

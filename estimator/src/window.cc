@@ -166,18 +166,14 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
   const ObservationKey key{state_id, landmark_id};
   CHECK(observations_.count(key) == 0) << "landmark " << landmark_id.value << " observed twice in state "
                                       << state_id.value;
-  ceres::ResidualBlockId residual = nullptr;
-  if (estimates_time_offset()) {
-    residual = problem_->AddResidualBlock(
-        WithFirstEstimates(Wrap(StereoFactorOf(state_id, landmark_id, z_px)),
-                           {BlockKey::Pose(state_id), BlockKey::Landmark(landmark_id), BlockKey::TimeOffset()}),
-        loss_.get(), s.pose, it->second.p_w, time_offset_);
-  } else {
-    residual = problem_->AddResidualBlock(
-        WithFirstEstimates(Wrap(StereoFactorOf(state_id, landmark_id, z_px)),
-                           {BlockKey::Pose(state_id), BlockKey::Landmark(landmark_id)}),
-        loss_.get(), s.pose, it->second.p_w);
+  std::vector<double*> blocks = {s.pose, it->second.p_w};
+  std::vector<BlockKey> keys = {BlockKey::Pose(state_id), BlockKey::Landmark(landmark_id)};
+  for (double* block : CalibrationBlocks()) {
+    blocks.push_back(block);
+    keys.push_back(block == time_offset_ ? BlockKey::TimeOffset() : BlockKey::Extrinsics());
   }
+  const ceres::ResidualBlockId residual = problem_->AddResidualBlock(
+      WithFirstEstimates(Wrap(StereoFactorOf(state_id, landmark_id, z_px)), std::move(keys)), loss_.get(), blocks);
   observations_[key] = Observation{z_px, residual};
   it->second.observed_from.insert(state_id);
 }
@@ -449,7 +445,7 @@ double Window::WhitenedError(StateId state_id, LandmarkId landmark_id, const Eig
   const Landmark& l = landmark(landmark_id);
   double residual[3];
   const double* params[2] = {s.pose, l.p_w};
-  std::unique_ptr<ceres::CostFunction> f(StereoFactor::Create(z_px, stereo_, model_.pixel_sigma));
+  std::unique_ptr<ceres::CostFunction> f(StereoFactor::Create(z_px, estimated_stereo(), model_.pixel_sigma));
   if (!f->Evaluate(params, residual, nullptr)) return std::numeric_limits<double>::infinity();
   const double error = Eigen::Map<Eigen::Vector3d>(residual).norm();
   return std::isfinite(error) ? error : std::numeric_limits<double>::infinity();

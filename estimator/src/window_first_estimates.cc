@@ -30,6 +30,7 @@ BlockKey Window::KeyOf(const double* block) const {
     if (block == landmark.p_w) return BlockKey::Landmark(id);
   }
   if (block == time_offset_) return BlockKey::TimeOffset();
+  if (block == extrinsic_) return BlockKey::Extrinsics();
   LOG(FATAL) << "a parameter block that is neither a state nor a landmark of the window";
   return {};
 }

@@ -34,7 +34,8 @@ void Window::RemoveState(StateId id) {
   for (auto it = priors_.begin(); it != priors_.end();) {
     const auto of_this = [&](const double* b) { return b == s.pose || b == s.speed_bias; };
     const auto mine = std::count_if(it->blocks.begin(), it->blocks.end(), of_this);
-    const auto calibration = std::count(it->blocks.begin(), it->blocks.end(), time_offset_);
+    const auto calibration = std::count(it->blocks.begin(), it->blocks.end(), time_offset_) +
+                             std::count(it->blocks.begin(), it->blocks.end(), extrinsic_);
     const bool touches = mine > 0;
     CHECK(!touches || mine + calibration == static_cast<std::ptrdiff_t>(it->blocks.size()))
         << "state " << id.value << " shares a prior with other blocks";

@@ -104,9 +104,11 @@ GaussNewtonLayout Window::Layout() const {
   for (const auto& [id, s] : states_) {
     if (variable(s.pose)) layout.dense.push_back(const_cast<double*>(s.pose));
   }
-  // The time offset next to the poses: a landmark's Schur update over its poses and the offset
+  // The calibration blocks next to the poses: a landmark's Schur update over its poses and the offset
   // stays one contiguous range when the newest poses see it.
-  if (estimates_time_offset() && variable(time_offset_)) layout.dense.push_back(const_cast<double*>(time_offset_));
+  for (double* block : CalibrationBlocks()) {
+    if (variable(block)) layout.dense.push_back(block);
+  }
   for (const auto& [id, s] : states_) {
     if (!variable(s.speed_bias)) continue;
     layout.chain.push_back(static_cast<int>(layout.dense.size()));
@@ -133,7 +135,7 @@ std::shared_ptr<ceres::ParameterBlockOrdering> Window::SchurOrdering() const {
     ordering->AddElementToGroup(const_cast<double*>(s.pose), group++);
     ordering->AddElementToGroup(const_cast<double*>(s.speed_bias), group++);
   }
-  if (estimates_time_offset()) ordering->AddElementToGroup(const_cast<double*>(time_offset_), group++);
+  for (double* block : CalibrationBlocks()) ordering->AddElementToGroup(block, group++);
   for (const auto& [id, landmark] : landmarks_) {
     const bool eliminated = in_prior.count(landmark.p_w) == 0;
     ordering->AddElementToGroup(const_cast<double*>(landmark.p_w), eliminated ? 0 : group++);
@@ -152,7 +154,7 @@ std::shared_ptr<ceres::ParameterBlockOrdering> Window::StatesFirstOrdering() con
     ordering->AddElementToGroup(const_cast<double*>(s.pose), 0);
     ordering->AddElementToGroup(const_cast<double*>(s.speed_bias), 0);
   }
-  if (estimates_time_offset()) ordering->AddElementToGroup(const_cast<double*>(time_offset_), 0);
+  for (double* block : CalibrationBlocks()) ordering->AddElementToGroup(block, 0);
   for (const auto& [id, landmark] : landmarks_) ordering->AddElementToGroup(const_cast<double*>(landmark.p_w), 1);
   return ordering;
 }

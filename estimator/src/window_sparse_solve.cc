@@ -79,8 +79,8 @@ SolveReport Window::SolveSparse(const SolverOptions& options) {
 
 Window::Leaving Window::SolvedOf(const VariableIds& variable) {
   Leaving solved = LeavingOf(variable.states, variable.landmarks);
-  if (estimates_time_offset() && !problem_->IsParameterBlockConstant(time_offset_)) {
-    solved.blocks.insert(time_offset_);  // and its prior
+  for (double* block : CalibrationBlocks()) {
+    if (!problem_->IsParameterBlockConstant(block)) solved.blocks.insert(block);  // and its prior
   }
   return solved;
 }
@@ -120,7 +120,7 @@ Window::IdOrderedCopy Window::CopyOf(const std::vector<ceres::ResidualBlockId>& 
     take(s.speed_bias);
   }
   for (const auto& [id, landmark] : landmarks_) take(landmark.p_w);
-  take(time_offset_);  // when estimated
+  for (const double* block : CalibrationBlocks()) take(block);
   CHECK_EQ(copy.blocks.size(), touched.size()) << "a residual touches a block that is no state, landmark or calibration";
   for (size_t k = 0; k < copy.blocks.size(); ++k) copy.copy_of[copy.blocks[k]] = copy.values.data() + offsets[k];
   return copy;
@@ -190,7 +190,7 @@ std::unordered_map<const double*, int> Window::EliminationGroups(const std::stri
     const bool eliminable = landmark.anchored_to.empty() && !in_prior.count(landmark.p_w);
     group[landmark.p_w] = one_segment && eliminable ? 0 : 1;
   }
-  group[time_offset_] = 1;  // seen by every observation
+  for (const double* block : CalibrationBlocks()) group[block] = 1;  // seen by every observation
   return group;
 }
 

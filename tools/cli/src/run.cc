@@ -10,8 +10,10 @@
 #include <optional>
 #include <sstream>
 
+
 #include <glog/logging.h>
 
+#include "run_calibration.h"
 #include "run_control.h"
 #include "run_output.h"
 #include "vio/estimator/estimator.h"
@@ -316,20 +318,6 @@ void FinishEstimates(const RunRequest& request, Estimator& estimator, RunOutput&
   }
 }
 
-// The camera-IMU time offset the run ends with (the calibration file's plus the estimate).
-void RecordTimeOffset(const EurocDataset& dataset, Estimator& estimator,
-                      const std::optional<Estimator::TimeOffsetSearchReport>& search, CalibrationReport* calibration) {
-  calibration->time_offset_estimated = estimator.window().estimates_time_offset();
-  calibration->time_offset_calibration_ms = 1e-6 * static_cast<double>(dataset.camera_time_offset_ns);
-  calibration->time_offset_ms = calibration->time_offset_calibration_ms + 1e3 * estimator.time_offset_s();
-  if (const std::optional<double> sigma = estimator.TimeOffsetSigma()) calibration->time_offset_sigma_ms = 1e3 * *sigma;
-  if (search) {
-    calibration->time_offset_search_ms = calibration->time_offset_calibration_ms + 1e3 * search->offset_s;
-    calibration->time_offset_search_sigma_ms = 1e3 * search->sigma_s;
-    calibration->time_offset_search_restarted = search->restart;
-  }
-}
-
 // --trajectory=smoothed: the offline refinement of every frame replaces the
 // last estimates; stopped by a signal, the iterate it reached (status interrupted).
 void RefineEstimates(const RunRequest& request, const Estimator& estimator, RunOutput& output, RunResult* result) {
@@ -505,7 +493,8 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset,
     FinishEstimates(request, estimator, output, solve_log, &result);
   }
   // After the final solve: batch's offset is the whole sequence's, not its online estimate's.
-  RecordTimeOffset(dataset, estimator, *search ? *search : estimator.time_offset_search(), &result.calibration);
+  RecordCalibration(dataset, estimator, *search ? *search : estimator.time_offset_search(), &result.calibration);
+  if (estimator.window().estimates_extrinsics()) WriteCalibration(dataset, estimator.window(), request.output_dir + "/calibration");
   if (refine && result.status == "ok") {
     solve_log.SetPhase("refinement");
     RefineEstimates(request, estimator, output, &result);

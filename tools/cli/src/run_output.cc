@@ -138,6 +138,24 @@ void RunOutput::WriteTiming(const RefinementReport& refinement) const {
   }
 }
 
+namespace {
+
+// summary.json's calibration.extrinsics_*: the correction's rotation and translation (norms and vectors).
+void WriteExtrinsics(const CalibrationReport& c, std::ostream& out) {
+  const auto vector = [](const Eigen::Vector3d& v) {
+    return "[" + JsonNumber(v.x()) + ", " + JsonNumber(v.y()) + ", " + JsonNumber(v.z()) + "]";
+  };
+  out << ", \"extrinsics_estimated\": " << (c.extrinsics_estimated ? "true" : "false")
+      << ", \"extrinsics_rotation_deg\": " << JsonNumber(c.extrinsics_rotation_deg.norm())
+      << ", \"extrinsics_translation_m\": " << JsonNumber(c.extrinsics_translation_m.norm())
+      << ", \"extrinsics_rotation_vector_deg\": " << vector(c.extrinsics_rotation_deg)
+      << ", \"extrinsics_translation_vector_m\": " << vector(c.extrinsics_translation_m);
+  if (c.extrinsics_rotation_sigma_deg) out << ", \"extrinsics_rotation_sigma_deg\": " << JsonNumber(*c.extrinsics_rotation_sigma_deg);
+  if (c.extrinsics_translation_sigma_m) out << ", \"extrinsics_translation_sigma_m\": " << JsonNumber(*c.extrinsics_translation_sigma_m);
+}
+
+}  // namespace
+
 void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_json, const RunRequest& request,
                              double peak_memory_mb, const std::string& waiting_reason) const {
   std::ofstream out = OpenForWriting(dir_ + "/summary.json.tmp");
@@ -169,6 +187,7 @@ void RunOutput::WriteSummary(const RunResult& r, const std::string& frontend_jso
         << ", \"sigma_ms\": " << JsonNumber(*r.calibration.time_offset_search_sigma_ms)
         << ", \"restarted\": " << (r.calibration.time_offset_search_restarted ? "true" : "false") << "}";
   }
+  WriteExtrinsics(r.calibration, out);
   out << "}";
   if (r.groundtruth_tilt_deg) out << ",\n  \"groundtruth_tilt_deg\": " << JsonNumber(*r.groundtruth_tilt_deg);
   if (r.evaluation) {

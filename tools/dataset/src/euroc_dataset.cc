@@ -134,13 +134,10 @@ EurocDataset ReadEuroc(const std::string& root, const EurocReadOptions& options)
 }
 
 void ApplyCalibrationFrom(const std::string& folder, EurocDataset* dataset) {
-  EurocReadOptions calibration_only;
-  calibration_only.read_imu = calibration_only.read_groundtruth = calibration_only.read_features = false;
-  calibration_only.check_images = false;
-  const EurocDataset calibration = ReadEuroc(folder, calibration_only);
-  dataset->cameras[0] = calibration.cameras[0];
-  dataset->cameras[1] = calibration.cameras[1];
-  dataset->imu_calibration = ReadImuYaml(FindSequenceFolders(folder).mav0 + "/imu0/sensor.yaml");
+  // Only the sensor.yaml files: a calibration folder (as `vio run` writes one) needs no frames.
+  const std::string mav0 = FindSequenceFolders(folder).mav0;
+  for (int i = 0; i < 2; ++i) dataset->cameras[i] = ReadCameraYaml(CameraFolder(mav0, i) + "/sensor.yaml");
+  dataset->imu_calibration = ReadImuYaml(mav0 + "/imu0/sensor.yaml");
 }
 
 void WriteEuroc(const EurocDataset& dataset, const std::string& root) {

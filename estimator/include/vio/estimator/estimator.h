@@ -65,6 +65,8 @@ class Estimator {
   double time_offset_s() const;
   /// Its marginal standard deviation at the current estimate [s]; nothing when not estimated.
   std::optional<double> TimeOffsetSigma() { return window_.TimeOffsetSigma(); }
+  /// The extrinsics' correction's marginal covariance (Window::ExtrinsicCovariance).
+  std::optional<Eigen::Matrix<double, 6, 6>> ExtrinsicCovariance() { return window_.ExtrinsicCovariance(); }
   /// The coarse time offset search at initialization, once it decided.
   struct TimeOffsetSearchReport {
     double offset_s = 0;  ///< where the gyro follows the camera best [s]
@@ -145,6 +147,8 @@ class Estimator {
   void CheckRotation(const StereoFrame& frame, Timestamp search_t_ns);
   /// With the offset estimated and time_offset_search_ms > 0: the search starts.
   void StartTimeOffsetSearch();
+  /// Makes the window estimate the calibration the options ask for (not with the local map).
+  void EstimateCalibration();
   /// The search's result: an input problem when it lies at its range's end, a recommended restart
   /// when beyond the prior (TimeOffsetSearchReport).
   void ApplyTimeOffsetSearch(const TimeOffsetSearch::Result& result);

@@ -217,6 +217,9 @@ struct ModelOptions {
   bool estimate_time_offset = true;       ///< the camera-IMU time offset is a state of the window
   double time_offset_prior_mean_ms = 0.0;   ///< prior mean of the offset (fixed when not estimated) [ms]
   double time_offset_prior_sigma_ms = 5.0;  ///< prior standard deviation of the offset [ms]
+  bool estimate_extrinsics = false;         ///< a correction of the camera-IMU extrinsics is a state of the window
+  double extrinsics_prior_sigma_deg = 1.0;  ///< prior standard deviation of its rotation, per axis [deg]
+  double extrinsics_prior_sigma_m = 0.02;   ///< prior standard deviation of its translation, per axis [m]
   double time_offset_search_ms = 100.0;  ///< range of the coarse search at initialization, either side [ms]; 0: none
 
   template <class V>
@@ -248,6 +251,13 @@ struct ModelOptions {
       Between(-1000, 1000));
     v("time_offset_prior_sigma_ms", time_offset_prior_sigma_ms,
       "camera-IMU time offset's prior standard deviation [ms]", Positive());
+    v("estimate_extrinsics", estimate_extrinsics,
+      "estimate a correction of the camera-IMU extrinsics (both cameras moved rigidly, the baseline kept) online, as "
+      "a state of the window under a zero-mean prior (docs/calibration.md); false: sensor.yaml's T_BS is exact");
+    v("extrinsics_prior_sigma_deg", extrinsics_prior_sigma_deg,
+      "camera-IMU extrinsics correction's prior standard deviation of the rotation, per axis [deg]", Positive(90));
+    v("extrinsics_prior_sigma_m", extrinsics_prior_sigma_m,
+      "camera-IMU extrinsics correction's prior standard deviation of the translation, per axis [m]", Positive(10));
     v("time_offset_search_ms", time_offset_search_ms,
       "with estimate_time_offset: in the first seconds of rotation the gyro is matched to the camera for offsets "
       "this far either side of time_offset_prior_mean_ms; a match beyond the prior starts the run again with the "

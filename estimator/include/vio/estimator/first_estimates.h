@@ -32,7 +32,7 @@ namespace vio {
 
 /// Which block of the window a factor parameter is.
 struct BlockKey {
-  enum class Kind { kPose, kSpeedBias, kLandmark, kTimeOffset };
+  enum class Kind { kPose, kSpeedBias, kLandmark, kTimeOffset, kExtrinsics };
   Kind kind = Kind::kPose;
   std::int64_t id = 0;  ///< StateId or LandmarkId value
 
@@ -40,6 +40,7 @@ struct BlockKey {
   static BlockKey SpeedBias(StateId s) { return {Kind::kSpeedBias, s.value}; }
   static BlockKey Landmark(LandmarkId l) { return {Kind::kLandmark, l.value}; }
   static BlockKey TimeOffset() { return {Kind::kTimeOffset, 0}; }
+  static BlockKey Extrinsics() { return {Kind::kExtrinsics, 0}; }
   bool operator<(const BlockKey& o) const { return kind != o.kind ? kind < o.kind : id < o.id; }
 };
 

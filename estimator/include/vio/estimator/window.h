@@ -106,8 +106,9 @@ class Window {
   /// Prior on one state at its current value (first state).
   void AddStatePrior(StateId id, const StatePrior& prior);
   Landmark& AddLandmark(LandmarkId id, const Eigen::Vector3d& p_w);
-  /// Stereo observation z = (u_L, u_R, v) [px] of `landmark` from `state`; with the time offset
-  /// estimated, a StereoTimeOffsetFactor with the image velocity SetCameraTiming gave (zero if none).
+  /// Stereo observation z = (u_L, u_R, v) [px] of `landmark` from `state`; with a calibration block
+  /// estimated, a StereoCalibrationFactor on it (the time offset's with the image velocity
+  /// SetCameraTiming gave, zero if none).
   void AddObservation(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px);
 
   // ---- calibration: the camera-IMU time offset -------------------------------
@@ -126,6 +127,23 @@ class Window {
   /// Its marginal standard deviation at the current estimate [s]; nothing when not estimated, held
   /// constant, the information is singular, or more than 500 states are variable (a dense inverse).
   std::optional<double> TimeOffsetSigma();
+  /// Holds every estimated calibration block (time offset, extrinsics) constant (or frees them).
+  void SetCalibrationConstant(bool constant);
+
+  // ---- calibration: the camera-IMU extrinsics --------------------------------
+  /// Makes a correction c = (dtheta [rad], dp [m]) of the rig's T_b_cl (R_b_c Exp(dtheta), p_b_c + dp,
+  /// the baseline kept; stereo_extrinsic_factor.h) a parameter block of the window under the prior
+  /// N(0, diag(sigma_rad^2 I3, sigma_m^2 I3)), starting at 0; every observation added from now on
+  /// depends on it. Once, before the first observation.
+  void EstimateExtrinsics(double sigma_rad, double sigma_m);
+  bool estimates_extrinsics() const { return extrinsic_prior_.residual != nullptr; }
+  /// The correction c (zero when not estimated).
+  Eigen::Matrix<double, 6, 1> extrinsic_correction() const { return Eigen::Map<const Eigen::Matrix<double, 6, 1>>(extrinsic_); }
+  /// Its marginal covariance at the current estimate (as TimeOffsetSigma; nothing when not estimated).
+  std::optional<Eigen::Matrix<double, 6, 6>> ExtrinsicCovariance();
+  /// The rig with the estimated correction applied (the given rig when not estimated): what
+  /// triangulation and gating use.
+  RectifiedStereo estimated_stereo() const;
   /// The offset t_a [s] the state's time was made with (its camera stamp minus t_ns) and its
   /// observations' image velocities [px/s] by landmark: what its observations' factors use.
   void SetCameraTiming(StateId state, double applied_offset_s, std::map<LandmarkId, Eigen::Vector3d> velocity_px_s);
@@ -268,8 +286,8 @@ class Window {
   };
 
   void AddImuResidual(ImuEdge& edge);
-  /// The stereo factor of one observation: StereoFactor, or with the time offset estimated a
-  /// StereoTimeOffsetFactor with the state's camera timing (window_calibration.cc).
+  /// The stereo factor of one observation: StereoFactor, or with calibration blocks estimated a
+  /// StereoCalibrationFactor on them, with the state's camera timing (window_calibration.cc).
   ceres::CostFunction* StereoFactorOf(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px) const;
   ceres::CostFunction* Wrap(ceres::CostFunction* factor) const { return wrapper_ ? wrapper_(factor) : factor; }
   /// The parameter blocks of states ([pose, speed_bias] each), then landmarks.
@@ -284,7 +302,7 @@ class Window {
     std::vector<LandmarkId> landmarks;
   };
   VariableIds VariableIdsOf() const;
-  /// The variable blocks' Leaving, with the time offset when it is estimated and variable.
+  /// The variable blocks' Leaving, with the calibration blocks that are estimated and variable.
   Leaving SolvedOf(const VariableIds& variable);
   IdOrderedCopy CopyOf(const std::vector<ceres::ResidualBlockId>& residuals, const LandmarkFactors& extra) const;
   std::unordered_map<const double*, int> EliminationGroups(const std::string& linear_solver) const;
@@ -351,6 +369,12 @@ class Window {
   double time_offset_[1] = {0.0};  ///< [s]; a parameter block once EstimateTimeOffset was called
   Prior time_offset_prior_;        ///< also in priors_; null residual: not estimated
   std::map<StateId, CameraTiming> camera_timing_;
+  double extrinsic_[6] = {};       ///< c = (dtheta, dp); a parameter block once EstimateExtrinsics was called
+  Prior extrinsic_prior_;          ///< also in priors_; null residual: not estimated
+  /// The estimated calibration blocks (time offset, then extrinsics), in that order.
+  std::vector<double*> CalibrationBlocks() const;
+  /// The marginal covariance of `block` (a calibration block), as TimeOffsetSigma.
+  std::optional<Eigen::MatrixXd> CalibrationCovariance(const double* block);
   /// Whether the last marginalization's prior had fewer rows than columns
   /// (Marginalize picks the next square root's factorization by it).
   bool last_prior_rank_deficient_ = false;

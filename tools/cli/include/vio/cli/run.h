@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "vio/cli/run_config.h"
 #include "vio/estimator/refinement.h"
 #include "vio/estimator/tracking_monitor.h"
@@ -80,6 +82,14 @@ struct CalibrationReport {
   /// prior's mean there (the offset lay beyond the prior).
   std::optional<double> time_offset_search_ms, time_offset_search_sigma_ms;
   bool time_offset_search_restarted = false;
+  /// The extrinsics' correction (estimate_extrinsics): both cameras turned rigidly in the body by
+  /// the rotation vector rotation_deg [deg] (body frame) and the left camera moved by translation_m
+  /// [m] (body frame); the sigmas are the largest standard deviation over directions of each, when
+  /// the covariance is available.
+  bool extrinsics_estimated = false;
+  Eigen::Vector3d extrinsics_rotation_deg = Eigen::Vector3d::Zero();
+  Eigen::Vector3d extrinsics_translation_m = Eigen::Vector3d::Zero();
+  std::optional<double> extrinsics_rotation_sigma_deg, extrinsics_translation_sigma_m;
 };
 
 struct RunResult {

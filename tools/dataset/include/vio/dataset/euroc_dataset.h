@@ -115,7 +115,7 @@ struct EurocReadOptions {
 EurocDataset ReadEuroc(const std::string& root, const EurocReadOptions& options = {});
 
 /// Replaces the camera and IMU calibration of `dataset` with those of the ASL
-/// folder `folder` (its mav0/{cam0,cam1,imu0}/sensor.yaml and camN/data.csv).
+/// folder `folder` (its mav0/{cam0,cam1,imu0}/sensor.yaml; no data.csv needed).
 void ApplyCalibrationFrom(const std::string& folder, EurocDataset* dataset);
 
 /// Writes a whole ASL folder (creates directories): imu0, cam0/cam1 (sensor.yaml,
