@@ -147,7 +147,6 @@ struct BlockSystem::Impl {
   MarginalizationPrior::TangentLinearization prior_linearization;
   Eigen::MatrixXd prior_part;  ///< one block of a prior's J^T J
   Eigen::MatrixXd U;
-  Eigen::MatrixXd UUt;
   /// Contiguous Schur updates waiting to be applied (SubtractPendingUpdates).
   std::vector<PendingUpdate> pending;
   std::vector<double> stacked;  ///< a group's U side by side (SubtractPendingUpdates)
