@@ -13,12 +13,6 @@
 #include "block_system_impl.h"
 
 namespace vio::marginalization {
-namespace {
-
-/// Rows of U U^T SubtractPackedUpdate sums at once (a pose has 6).
-constexpr int kSumRows = 16;
-
-}  // namespace
 
 BlockSystem::Impl::Impl(ceres::Problem* p, BlockLayout l, const RankThreshold& t) : problem(p), threshold(t) {
   Build(std::move(l));
@@ -204,7 +198,6 @@ void BlockSystem::Impl::SubtractPackedUpdate(const EliminatedBlock& block, const
     b.segment(a.offset, a.size).noalias() -= U.middleRows(rp, a.size) * c;
   }
   const Eigen::Index depth = U.cols();
-  double sum[kSumRows];
   for (size_t p = 0, rp = 0; p < block.coupled.size(); rp += dense[block.coupled[p]].size, ++p) {
     const Columns& a = dense[block.coupled[p]];
     for (size_t q = p, rq = rp; q < block.coupled.size(); rq += dense[block.coupled[q]].size, ++q) {
@@ -212,16 +205,11 @@ void BlockSystem::Impl::SubtractPackedUpdate(const EliminatedBlock& block, const
       for (int j = 0; j < c2.size; ++j) {
         // Within a diagonal block only its upper triangle (the rank update's).
         const int rows = p == q ? j + 1 : a.size;
-        for (int first = 0; first < rows; first += kSumRows) {
-          const int count = std::min(kSumRows, rows - first);
-          std::fill(sum, sum + count, 0.0);
-          for (Eigen::Index k = 0; k < depth; ++k) {
-            const double* u = &U(static_cast<Eigen::Index>(rp) + first, k);
-            const double v = U(static_cast<Eigen::Index>(rq) + j, k);
-            for (int i = 0; i < count; ++i) sum[i] += u[i] * v;
-          }
-          double* column = &H(a.offset + first, c2.offset + j);
-          for (int i = 0; i < count; ++i) column[i] -= sum[i];
+        double* column = &H(a.offset, c2.offset + j);
+        for (int i = 0; i < rows; ++i) {
+          double sum = 0.0;
+          for (Eigen::Index k = 0; k < depth; ++k) sum += U(rp + i, k) * U(rq + j, k);
+          column[i] -= sum;
         }
       }
     }
