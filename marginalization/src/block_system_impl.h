@@ -176,7 +176,7 @@ struct BlockSystem::Impl {
   bool AddGeneric(const Residual& residual, double* cost);
   bool EvaluateOnTangents(const Residual& residual, double* cost);
   bool RefreshPlusJacobians();
-  static bool HasTangentsOf3Or6(const Residual& residual);
+  static bool HasTangentsOf1Or3Or6(const Residual& residual);
   template <typename Residuals, typename WithJacobian>
   void Accumulate(const Residual& residual, const Residuals& res, const WithJacobian& with_jacobian);
   bool AddPrior(const Residual& residual, double* cost);
