@@ -9,27 +9,6 @@ namespace {
 /// window) 48-96 factor about 3 % faster than Eigen's 32.
 constexpr Eigen::Index kRestPanel = 64;
 
-/// S = L L^T in place on S's lower triangle, panel by panel: the panel's
-/// diagonal block factored, its column block solved, the trailing matrix
-/// updated by one rank-kRestPanel product (Eigen's blocked algorithm). Eigen's
-/// LLT of an upper triangle factors the transposed, row-major matrix and takes
-/// about 1.2x as long. False when a pivot is not positive.
-bool FactorLowerInPlace(Eigen::MatrixXd& S) {
-  const Eigen::Index n = S.rows();
-  for (Eigen::Index p = 0; p < n; p += kRestPanel) {
-    const Eigen::Index w = std::min(kRestPanel, n - p);
-    Eigen::Ref<Eigen::MatrixXd> diagonal = S.block(p, p, w, w);
-    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Lower> panel(diagonal);  // in place
-    if (panel.info() != Eigen::Success) return false;
-    const Eigen::Index rest = n - p - w;
-    if (rest == 0) break;
-    auto below = S.block(p + w, p, rest, w);
-    S.block(p, p, w, w).triangularView<Eigen::Lower>().transpose().solveInPlace<Eigen::OnTheRight>(below);
-    S.bottomRightCorner(rest, rest).selfadjointView<Eigen::Lower>().rankUpdate(below, -1.0);
-  }
-  return true;
-}
-
 /// A maximal run of consecutive columns among ascending ones.
 struct Run {
   int column = 0;    ///< its first column
@@ -81,6 +60,27 @@ void MultiplyInPlace(const Matrix& a, int at, ChainSolver::RowMajorMatrix* r, Ch
 }
 
 }  // namespace
+
+/// S = L L^T in place on S's lower triangle, panel by panel: the panel's
+/// diagonal block factored, its column block solved, the trailing matrix
+/// updated by one rank-kRestPanel product (Eigen's blocked algorithm). Eigen's
+/// LLT of an upper triangle factors the transposed, row-major matrix and takes
+/// about 1.2x as long. False when a pivot is not positive.
+bool FactorLowerInPlace(Eigen::MatrixXd& S) {
+  const Eigen::Index n = S.rows();
+  for (Eigen::Index p = 0; p < n; p += kRestPanel) {
+    const Eigen::Index w = std::min(kRestPanel, n - p);
+    Eigen::Ref<Eigen::MatrixXd> diagonal = S.block(p, p, w, w);
+    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Lower> panel(diagonal);  // in place
+    if (panel.info() != Eigen::Success) return false;
+    const Eigen::Index rest = n - p - w;
+    if (rest == 0) break;
+    auto below = S.block(p + w, p, rest, w);
+    S.block(p, p, w, w).triangularView<Eigen::Lower>().transpose().solveInPlace<Eigen::OnTheRight>(below);
+    S.bottomRightCorner(rest, rest).selfadjointView<Eigen::Lower>().rankUpdate(below, -1.0);
+  }
+  return true;
+}
 
 // Block-banded Cholesky H_cc = L L^T, block row by block row.
 bool ChainSolver::FactorChain(const Eigen::MatrixXd& H, const std::vector<ChainBlock>& chain) {

@@ -47,15 +47,20 @@ double SquaredNorm(const ceres::Problem& problem, const std::vector<double*>& bl
 }
 
 /// Solves H dx = -b for H symmetric positive definite, given by its upper
-/// triangle (semi-definite falls back to LDLT). False when no finite solution exists.
-bool SolveDense(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, Eigen::VectorXd* dx) {
+/// triangle (semi-definite falls back to LDLT), factored by panels in
+/// `factor` (FactorLowerInPlace, memory kept between solves). False when no
+/// finite solution exists.
+bool SolveDense(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, Eigen::MatrixXd* factor, Eigen::VectorXd* dx) {
   if (H.rows() == 0) {
     dx->resize(0);
     return true;
   }
-  const Eigen::LLT<Eigen::MatrixXd, Eigen::Upper> llt(H);
-  if (llt.info() == Eigen::Success) {
-    *dx = llt.solve(-b);
+  factor->resize(H.rows(), H.cols());
+  factor->triangularView<Eigen::Lower>() = H.transpose();
+  if (FactorLowerInPlace(*factor)) {
+    *dx = -b;
+    factor->triangularView<Eigen::Lower>().solveInPlace(*dx);
+    factor->transpose().triangularView<Eigen::Upper>().solveInPlace(*dx);
   } else {
     *dx = Eigen::LDLT<Eigen::MatrixXd, Eigen::Upper>(H).solve(-b);
   }
@@ -76,6 +81,7 @@ struct GaussNewtonSolver::System {
   ChainSolver chain_solver;
   /// The layout's values before the last step, dense then eliminated blocks.
   std::vector<double> before_step;
+  Eigen::MatrixXd dense_factor;  ///< SolveDense's factor, kept between steps
 
   System(ceres::Problem* p, GaussNewtonLayout l)
       : problem(p), layout(std::move(l)), equations(p, BlockLayoutOf(layout)) {
@@ -147,7 +153,7 @@ struct GaussNewtonSolver::System {
     const Eigen::VectorXd& b = equations.b();
     Eigen::VectorXd dx_dense;
     const bool chained = !chain.empty() && chain_solver.Solve(H, b, chain, chain_bandwidth, &dx_dense);
-    if (!chained && !SolveDense(H, b, &dx_dense)) return step;
+    if (!chained && !SolveDense(H, b, &dense_factor, &dx_dense)) return step;
     Eigen::VectorXd dx;
     equations.BackSubstitute(dx_dense, &dx);
     if (!dx.allFinite()) return step;

@@ -254,6 +254,7 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   const Leaving leaving = LeavingOf(state_ids, landmark_ids);
   marginalization::MarginalizationOptions options;
   options.residual_order = ResidualOrderOf(leaving);
+  options.kept_order = StateColumnOrder();
   // Rank-deficient priors come in runs: after one, no unpivoted attempt at the
   // next square root (a whole factorization that would fail its pivot test).
   if (last_prior_rank_deficient_) options.sqrt_method = marginalization::SqrtMethod::kPivotedCholeskyOnly;

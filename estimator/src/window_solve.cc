@@ -122,6 +122,15 @@ GaussNewtonLayout Window::Layout() const {
   return layout;
 }
 
+std::vector<const double*> Window::StateColumnOrder() const {
+  std::vector<const double*> order;
+  order.reserve(2 * states_.size() + 1);
+  for (const auto& [id, s] : states_) order.push_back(s.speed_bias);
+  for (const auto& [id, s] : states_) order.push_back(s.pose);
+  if (estimates_time_offset()) order.push_back(time_offset_);
+  return order;
+}
+
 // Landmarks (group 0) are eliminated first by the Schur complement; the
 // state blocks follow, one group each in id order. Ceres orders the blocks
 // inside one group by address, so LM runs depend on the heap layout in the

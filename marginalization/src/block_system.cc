@@ -189,19 +189,29 @@ void BlockSystem::Impl::StackCouplings(const EliminatedBlock& block, int first, 
 }
 
 // b -= U c and H -= U U^T block pair by block pair, U packed (StackCouplings).
+// Each entry of U U^T is summed over U's columns in order from zero, as the
+// blocked rank update summed it into a zeroed buffer: the same values,
+// without an n x n buffer to clear and scatter for each block.
 void BlockSystem::Impl::SubtractPackedUpdate(const EliminatedBlock& block, const Eigen::VectorXd& c) {
-  const Eigen::Index rows = U.rows();
   for (size_t p = 0, rp = 0; p < block.coupled.size(); rp += dense[block.coupled[p]].size, ++p) {
     const Columns& a = dense[block.coupled[p]];
     b.segment(a.offset, a.size).noalias() -= U.middleRows(rp, a.size) * c;
   }
-  UUt.setZero(rows, rows);
-  UUt.selfadjointView<Eigen::Upper>().rankUpdate(U);
+  const Eigen::Index depth = U.cols();
   for (size_t p = 0, rp = 0; p < block.coupled.size(); rp += dense[block.coupled[p]].size, ++p) {
     const Columns& a = dense[block.coupled[p]];
     for (size_t q = p, rq = rp; q < block.coupled.size(); rq += dense[block.coupled[q]].size, ++q) {
       const Columns& c2 = dense[block.coupled[q]];
-      H.block(a.offset, c2.offset, a.size, c2.size) -= UUt.block(rp, rq, a.size, c2.size);
+      for (int j = 0; j < c2.size; ++j) {
+        // Within a diagonal block only its upper triangle (the rank update's).
+        const int rows = p == q ? j + 1 : a.size;
+        double* column = &H(a.offset, c2.offset + j);
+        for (int i = 0; i < rows; ++i) {
+          double sum = 0.0;
+          for (Eigen::Index k = 0; k < depth; ++k) sum += U(rp + i, k) * U(rq + j, k);
+          column[i] -= sum;
+        }
+      }
     }
   }
 }

@@ -76,15 +76,18 @@ void BlockSystem::Impl::AddDenseProduct(const Slot& i, const Slot& j, const Prod
 
 bool BlockSystem::Impl::AddGeneric(const Residual& residual, double* cost) {
   if (!EvaluateOnTangents(residual, cost)) return false;
-  // A stereo residual (3 rows on 6- and 3-dimensional tangents) takes
-  // fixed-size products; every other shape the dynamic ones.
-  if (residual.rows == 3 && HasTangentsOf3Or6(residual)) {
+  // A stereo residual (3 rows on a pose's 6-, a landmark's 3- and the time
+  // offset's 1-dimensional tangent) takes fixed-size products; every other
+  // shape the dynamic ones.
+  if (residual.rows == 3 && HasTangentsOf1Or3Or6(residual)) {
     Accumulate(residual, Eigen::Map<const Eigen::Vector3d>(r.data()), [&](const Slot& slot, const auto& use) {
       const double* data = jacobians.data() + slot.jacobian;
       if (slot.tangent == 6) {
         use(Eigen::Map<const Eigen::Matrix<double, 3, 6, Eigen::RowMajor>>(data));
-      } else {
+      } else if (slot.tangent == 3) {
         use(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(data));
+      } else {
+        use(Eigen::Map<const Eigen::Vector3d>(data));
       }
     });
     return true;
@@ -146,9 +149,9 @@ bool BlockSystem::Impl::RefreshPlusJacobians() {
   return true;
 }
 
-bool BlockSystem::Impl::HasTangentsOf3Or6(const Residual& residual) {
+bool BlockSystem::Impl::HasTangentsOf1Or3Or6(const Residual& residual) {
   for (const Slot& slot : residual.slots) {
-    if (slot.variable() && slot.tangent != 3 && slot.tangent != 6) return false;
+    if (slot.variable() && slot.tangent != 1 && slot.tangent != 3 && slot.tangent != 6) return false;
   }
   return true;
 }

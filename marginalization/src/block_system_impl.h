@@ -147,7 +147,6 @@ struct BlockSystem::Impl {
   MarginalizationPrior::TangentLinearization prior_linearization;
   Eigen::MatrixXd prior_part;  ///< one block of a prior's J^T J
   Eigen::MatrixXd U;
-  Eigen::MatrixXd UUt;
   /// Contiguous Schur updates waiting to be applied (SubtractPendingUpdates).
   std::vector<PendingUpdate> pending;
   std::vector<double> stacked;  ///< a group's U side by side (SubtractPendingUpdates)
@@ -177,7 +176,7 @@ struct BlockSystem::Impl {
   bool AddGeneric(const Residual& residual, double* cost);
   bool EvaluateOnTangents(const Residual& residual, double* cost);
   bool RefreshPlusJacobians();
-  static bool HasTangentsOf3Or6(const Residual& residual);
+  static bool HasTangentsOf1Or3Or6(const Residual& residual);
   template <typename Residuals, typename WithJacobian>
   void Accumulate(const Residual& residual, const Residuals& res, const WithJacobian& with_jacobian);
   bool AddPrior(const Residual& residual, double* cost);

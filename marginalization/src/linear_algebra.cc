@@ -168,14 +168,15 @@ Eigen::MatrixXd ProbeVectors(Eigen::Index n) {
 }
 
 /// Whether Jp^T Jp gives H back to kReconstructionTolerance (relative,
-/// Frobenius), estimated on kProbes probe vectors: O(n^2) instead of the n^3
-/// of forming Jp^T Jp. The failure it guards against (amplified round-off
-/// after a round-off pivot) is many orders above the tolerance.
-bool Reproduces(const Eigen::MatrixXd& Jp, const Eigen::MatrixXd& H) {
+/// Frobenius), or to `dropped`, the most a remainder the factorization dropped
+/// may hold, when that is more; estimated on kProbes probe vectors: O(n^2)
+/// instead of the n^3 of forming Jp^T Jp. The failure it guards against
+/// (amplified round-off after a round-off pivot) is many orders above both.
+bool Reproduces(const Eigen::MatrixXd& Jp, const Eigen::MatrixXd& H, double dropped = 0.0) {
   const Eigen::MatrixXd V = ProbeVectors(H.cols());
   const Eigen::MatrixXd JpV = Jp * V;
   const Eigen::MatrixXd error = Jp.transpose() * JpV - H * V;
-  return error.norm() <= kReconstructionTolerance * H.norm() * std::sqrt(static_cast<double>(kProbes));
+  return error.norm() <= std::max(kReconstructionTolerance * H.norm(), dropped) * std::sqrt(static_cast<double>(kProbes));
 }
 
 /// Jp = L^T, r0 = L^-1 b from the blocked Cholesky factor H = L L^T when
@@ -284,9 +285,13 @@ SqrtInformation SqrtByPivotedCholesky(const Eigen::MatrixXd& H, const Eigen::Vec
     if (i < rank) Pb(i) = b(factor.order[i]);
   }
   sqrt.residual = factor.L.topRows(rank).triangularView<Eigen::Lower>().solve(Pb);
-  // A remainder that is not round-off (H indefinite beyond it): the
-  // eigen-decomposition, which drops exactly the weak directions, is used.
-  if (!Reproduces(sqrt.sqrt_information, H)) return SqrtByEigen(H, b, threshold);
+  // The remainder left out has a diagonal at or below the cutoff: positive
+  // semi-definite, its Frobenius norm is at most its trace, (n - rank) times
+  // the cutoff (the eigen-decomposition's square root leaves as much). One
+  // that is not (H indefinite beyond round-off): the eigen-decomposition,
+  // which drops exactly the weak directions, is used.
+  const double dropped = 2.0 * static_cast<double>(n - rank) * cutoff;
+  if (!Reproduces(sqrt.sqrt_information, H, dropped)) return SqrtByEigen(H, b, threshold);
   sqrt.information = std::move(H_symmetric);
   return sqrt;
 }

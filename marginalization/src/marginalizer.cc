@@ -97,10 +97,23 @@ void SplitMarginalized(const ceres::Problem& problem, const std::vector<double*>
   }
 }
 
+/// The kept blocks listed in `order` first, in that order, then the others as they were.
+void OrderKept(const std::vector<const double*>& order, std::vector<double*>* kept) {
+  if (order.empty()) return;
+  std::unordered_map<const double*, size_t> position;
+  position.reserve(order.size());
+  for (size_t k = 0; k < order.size(); ++k) position.emplace(order[k], k);
+  const auto rank = [&](const double* block) {
+    const auto it = position.find(block);
+    return it != position.end() ? it->second : order.size();
+  };
+  std::stable_sort(kept->begin(), kept->end(), [&](const double* a, const double* b) { return rank(a) < rank(b); });
+}
+
 MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector<double*>& marg,
-                                const std::vector<ceres::ResidualBlockId>& order) {
+                                const MarginalizationOptions& options) {
   MarkovBlanket blanket;
-  blanket.residual_blocks = ResidualBlocksTouching(problem, marg, order);
+  blanket.residual_blocks = ResidualBlocksTouching(problem, marg, options.residual_order);
   const BlockSet marg_set(marg.begin(), marg.end());
   BlockSet kept_seen;
   std::unordered_map<const double*, BlockSet> coupled;
@@ -126,6 +139,7 @@ MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector
       }
     }
   }
+  OrderKept(options.kept_order, &blanket.kept);
   std::vector<double*> marg_variable;
   std::copy_if(marg.begin(), marg.end(), std::back_inserter(marg_variable),
                [&problem](double* block) { return IsVariable(problem, block); });
@@ -232,7 +246,7 @@ MarginalizationResult ComputeMarginalization(ceres::Problem* problem,
                                              const MarginalizationOptions& options) {
   CHECK(problem != nullptr);
   const std::vector<double*> marg = UniqueBlocksInProblem(*problem, to_marginalize);
-  MarkovBlanket blanket = FindMarkovBlanket(*problem, marg, options.residual_order);
+  MarkovBlanket blanket = FindMarkovBlanket(*problem, marg, options);
   MarginalizationResult result;
   result.marginalized_residual_blocks = blanket.residual_blocks;
   if (!blanket.kept.empty()) {

@@ -11,6 +11,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
+#include <Eigen/QR>
 #include <gtest/gtest.h>
 
 namespace vio::marginalization {
@@ -267,6 +268,33 @@ TEST_P(SqrtInformationFromHessianTest, KeepsTheRankOfAWindowLikeMarginal) {
       EXPECT_LE((Jp.array() != 0.0).count(), rank * n - rank * (rank - 1) / 2) << "seed " << seed;
     }
   }
+}
+
+// Weak directions just below the rank threshold (eigenvalues 2e-13 and 5e-13
+// of the largest, under the 1e-12 cutoff) leave the pivoted factor a
+// remainder of that size, more than 1e-13 of H but no more than the dropped
+// diagonal allows: the pivoted factor is kept (no eigen fallback), it drops
+// those directions as the eigen square root does, and gives H back to what it
+// dropped.
+TEST(SqrtInformationFromHessian, WeakDirectionsBelowTheThresholdKeepThePivotedFactor) {
+  std::mt19937 rng(16);
+  const int n = 14;
+  const Eigen::MatrixXd Q = RandomMatrix(n, n, &rng).householderQr().householderQ();
+  Eigen::VectorXd lambda(n);
+  lambda << 1.0, 0.8, 0.5, 0.3, 0.2, 0.1, 0.05, 0.02, 0.01, 5e-13, 5e-13, 2e-13, 0.0, 0.0;
+  const Eigen::MatrixXd H = Q * lambda.asDiagonal() * Q.transpose();
+  const Eigen::VectorXd b = H * RandomMatrix(n, 1, &rng);
+  const SqrtInformation eigen = SqrtInformationFromHessian(H, b, {}, SqrtMethod::kEigen);
+  const SqrtInformation pivoted = SqrtInformationFromHessian(H, b, {}, SqrtMethod::kPivotedCholeskyOnly);
+  const Eigen::MatrixXd& Jp = pivoted.sqrt_information;
+  ASSERT_EQ(eigen.sqrt_information.rows(), 9);
+  ASSERT_EQ(Jp.rows(), 9);
+  const double error = RelativeError(Jp.transpose() * Jp, H);
+  EXPECT_GT(error, 1e-13);  // what made the eigen fallback run before
+  EXPECT_LT(error, 2.0 * (n - 9) * 1e-12 * H.diagonal().maxCoeff() / H.norm());
+  const Eigen::Index rank = Jp.rows();
+  EXPECT_LE((Jp.array() != 0.0).count(), rank * n - rank * (rank - 1) / 2);  // L^T P, not eigenvectors
+  EXPECT_NEAR(pivoted.residual.squaredNorm(), eigen.residual.squaredNorm(), 1e-9 * eigen.residual.squaredNorm());
 }
 
 TEST(SqrtInformationFromHessian, DefiniteInformationTakesTheCholeskyFactor) {

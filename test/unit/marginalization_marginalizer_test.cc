@@ -320,6 +320,22 @@ TEST_F(LinearChainTest, ComputeMarginalizationLeavesTheProblemUnchanged) {
   EXPECT_EQ(result.prior->sqrt_information().cols(), 2 + 3);
 }
 
+// kept_order puts the listed kept blocks first, in its order; the prior is
+// the same marginal with its columns permuted.
+TEST_F(LinearChainTest, KeptOrderOrdersThePriorsBlocks) {
+  const std::vector<double*> marginalized = {model_.block(0), model_.block(1)};
+  const MarginalizationResult by_appearance = ComputeMarginalization(&problem_, marginalized);
+  ASSERT_EQ(by_appearance.kept_blocks, (std::vector<double*>{model_.block(2), model_.block(3)}));
+  MarginalizationOptions options;
+  options.kept_order = {model_.block(4), model_.block(3)};  // block 4 is not kept: skipped
+  const MarginalizationResult ordered = ComputeMarginalization(&problem_, marginalized, options);
+  ASSERT_EQ(ordered.kept_blocks, (std::vector<double*>{model_.block(3), model_.block(2)}));
+  Eigen::MatrixXd permuted(5, 5);  // block 3 (3 columns) first, then block 2 (2)
+  const Eigen::MatrixXd& H = by_appearance.prior->information();
+  permuted << H.block(2, 2, 3, 3), H.block(2, 0, 3, 2), H.block(0, 2, 2, 3), H.block(0, 0, 2, 2);
+  EXPECT_LT(RelativeError(ordered.prior->information(), permuted), 1e-12);
+}
+
 TEST_F(LinearChainTest, BlockNotInTheProblemIsRejected) {
   double stranger[2] = {0.0, 0.0};
   EXPECT_THROW(ComputeMarginalization(&problem_, {stranger}), std::invalid_argument);

@@ -20,6 +20,11 @@
 
 namespace vio {
 
+/// S = L L^T in place on S's lower triangle (S symmetric, its lower triangle
+/// read) by panels, each trailing update one wide rank update. False when a
+/// pivot is not positive.
+bool FactorLowerInPlace(Eigen::MatrixXd& S);
+
 /// The columns of one block of the chain.
 struct ChainBlock {
   int offset = 0;

@@ -257,6 +257,9 @@ class Window {
   GaussNewtonLayout Layout() const;
 
  private:
+  /// The state blocks in a marginalization's kept order: speed/bias blocks,
+  /// poses, the time offset (MarginalizationOptions::kept_order).
+  std::vector<const double*> StateColumnOrder() const;
   struct ImuEdge {
     StateId from;
     StateId to;

@@ -49,6 +49,14 @@ struct MarginalizationOptions {
   /// x_fe for the linear model), and holds its Jacobian at x0
   /// (MarginalizationPrior::HoldJacobianAtLinearizationPoint).
   std::function<const double*(const double* block)> first_estimate;
+  /// The kept blocks' column order, when not empty: the kept blocks listed
+  /// here come first, in this order, then the others in order of first
+  /// appearance. A window passes its state blocks with the poses last and the
+  /// block every observation touches (the time offset) after them, right
+  /// before the marginalized states' poses: the poses seeing one landmark are
+  /// then mostly one contiguous range, and its Schur update one rank update in
+  /// place.
+  std::vector<const double*> kept_order;
 };
 
 struct MarginalizationResult {
