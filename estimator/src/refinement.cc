@@ -57,14 +57,14 @@ void AddStates(const MeasurementLog& log, const StartValue& start, const Estimat
   }
 }
 
-Eigen::Isometry3d BodyPose(const State& s) { return Eigen::Translation3d(s.p_w_b()) * s.q_w_b(); }
+Eigen::Isometry3d StartPose(const State& s) { return Eigen::Translation3d(s.p_w_b()) * s.q_w_b(); }
 
 // A landmark never estimated online: triangulated from all its views at the states' start values
 // (loose bounds: a start value, not a gate), else stereo-triangulated from the first view that allows it.
 std::optional<Eigen::Vector3d> Triangulated(const std::vector<std::pair<StateId, Eigen::Vector3d>>& views,
                                             const ModelOptions& model, const Window& whole) {
   std::vector<StereoView> stereo_views;
-  for (const auto& [state, z] : views) stereo_views.push_back({BodyPose(whole.state(state)), z});
+  for (const auto& [state, z] : views) stereo_views.push_back({StartPose(whole.state(state)), z});
   TriangulationOptions triangulation;
   triangulation.pixel_sigma = model.pixel_sigma;
   triangulation.max_reprojection_sigma = model.max_whitened_residual;
@@ -73,7 +73,7 @@ std::optional<Eigen::Vector3d> Triangulated(const std::vector<std::pair<StateId,
   if (result.p_w) return result.p_w;
   for (const auto& [state, z] : views) {
     const std::optional<Eigen::Vector3d> p_cl = TriangulateRectified(z, whole.stereo(), model.min_disparity_px);
-    if (p_cl && p_cl->z() <= model.max_depth_m) return BodyPose(whole.state(state)) * whole.stereo().T_b_cl * *p_cl;
+    if (p_cl && p_cl->z() <= model.max_depth_m) return StartPose(whole.state(state)) * whole.stereo().T_b_cl * *p_cl;
   }
   return std::nullopt;
 }
