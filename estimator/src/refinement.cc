@@ -101,11 +101,14 @@ void AddLandmarks(const MeasurementLog& log, const LandmarkStarts& landmarks, co
   }
 }
 
-// SolveWhole's solve, stopped at `function_tolerance`.
-SolveReport SolveWholeTo(Window& window, const EstimatorOptions& options, double function_tolerance) {
+}  // namespace
+
+SolveReport SolveWhole(Window& window, const EstimatorOptions& options) {
   SolverOptions solver = options.solver;
   solver.max_iterations = options.batch.batch_final_iterations;
-  solver.function_tolerance = function_tolerance;
+  // Ceres' own tolerance: the default function_tolerance (1e-3) is set for
+  // the Gauss-Newton steps of a window, not for the final solve of everything.
+  solver.function_tolerance = 1e-6;
   // Bounded by iterations only (a configured wall-time bound is for a window's
   // solves): the final estimate does not depend on machine load.
   solver.max_solver_time_s = 0;
@@ -114,14 +117,6 @@ SolveReport SolveWholeTo(Window& window, const EstimatorOptions& options, double
   // dense pose system (hybrid V2_01, 40 s: 17.5 s per iteration against 1.0 s).
   solver.linear_solver = "sparse_full";
   return window.SolveSparse(solver);
-}
-
-}  // namespace
-
-SolveReport SolveWhole(Window& window, const EstimatorOptions& options) {
-  // Ceres' own tolerance: the default function_tolerance (1e-3) is set for
-  // the Gauss-Newton steps of a window, not for the final solve of everything.
-  return SolveWholeTo(window, options, 1e-6);
 }
 
 RefinementReport Refine(const MeasurementLog& log, const StartValue& start, const LandmarkStarts& landmarks,
@@ -138,7 +133,7 @@ RefinementReport Refine(const MeasurementLog& log, const StartValue& start, cons
   report.states = static_cast<int>(whole.states().size());
   report.landmarks = static_cast<int>(whole.landmarks().size());
   if (report.states > 0) {
-    const SolveReport solve = SolveWholeTo(whole, options, options.batch.smoothed_function_tolerance);
+    const SolveReport solve = SolveWhole(whole, options);
     report.iterations = solve.iterations;
     report.initial_cost = solve.initial_cost;
     report.final_cost = solve.final_cost;

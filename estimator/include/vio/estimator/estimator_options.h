@@ -154,8 +154,6 @@ struct LocalMapOptions {
 struct BatchOptions {
   int batch_final_iterations = 20;  ///< Gauss-Newton iterations of the final full solve [count]
   int batch_solve_every = 5;        ///< while running, solve the recent states every this many frames [frames]
-  /// --trajectory=smoothed: the refinement stops when an iteration lowers the cost by less than this fraction [].
-  double smoothed_function_tolerance = 1e-4;
 
   template <class V>
   void Visit(V& v) {
@@ -163,10 +161,6 @@ struct BatchOptions {
       "batch: Gauss-Newton iterations of the final solve over every state and landmark [count]", AtLeast(1));
     v("batch_solve_every", batch_solve_every,
       "batch: while running, solve the recent states every this many frames (IMU prediction between) [frames]", AtLeast(1));
-    v("smoothed_function_tolerance", smoothed_function_tolerance,
-      "--trajectory=smoothed: the refinement (at most batch_final_iterations iterations) stops when an iteration "
-      "lowers the cost by less than this fraction of it []",
-      Positive(1));
   }
 };
 
