@@ -120,6 +120,9 @@ FrameEstimate Estimator::ProcessFrame(const StereoFrame& camera_frame) {
   if (log_ && log_->time_offset) log_->time_offset->estimate_s = window_.time_offset_s();
   PruneImu(window_.states().begin()->second.t_ns);
   for (const State& s : window_.removals().leaving_states) left_window_.push_back(EstimateOf(s));
+  if (log_) {
+    for (const auto& [id, p_w] : window_.removals().leaving_landmarks) log_->landmarks[id] = p_w;
+  }
   FrameEstimate estimate = Estimate(frame);
   timing.total_ms = MillisecondsSince(start);
   estimate.timing = timing;
@@ -351,9 +354,11 @@ std::vector<FrameEstimate> Estimator::Refine(RefinementReport* report) const {
     s->SetSpeedBias(it->second.v_w_b, it->second.gyro_bias, it->second.accel_bias);
     return true;
   };
+  LandmarkStarts landmarks = log_->landmarks;
+  for (const auto& [id, landmark] : window_.landmarks()) landmarks[id] = landmark.position();
   Window whole(options_.model, window_.estimated_stereo());
   whole.SetSolveControl(window_.solve_control());
-  *report = vio::Refine(*log_, start, options_, whole);
+  *report = vio::Refine(*log_, start, landmarks, options_, whole);
   if (!report->usable) return refined;
   for (const auto& [id, s] : whole.states()) refined.push_back(EstimateOf(s));
   return refined;

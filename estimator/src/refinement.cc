@@ -1,11 +1,13 @@
 #include "vio/estimator/refinement.h"
 
 #include <chrono>
+#include <optional>
 #include <utility>
 
 #include <glog/logging.h>
 
-#include "vio/estimator/policy.h"
+#include "vio/estimator/stereo_geometry.h"
+#include "vio/estimator/triangulation.h"
 #include "vio/estimator/types.h"
 
 namespace vio {
@@ -33,8 +35,8 @@ void AddFirstPrior(const MeasurementLog& log, StateId first, Window& whole) {
   }
 }
 
-// The states (at their start values), the first prior, the IMU factors, the landmarks and observations.
-void Build(const MeasurementLog& log, const StartValue& start, const EstimatorOptions& options, Window& whole) {
+// The states (at their start values), the first prior and the IMU factors.
+void AddStates(const MeasurementLog& log, const StartValue& start, const EstimatorOptions& options, Window& whole) {
   if (log.time_offset) {
     whole.EstimateTimeOffset(log.time_offset->prior_mean_s, log.time_offset->prior_sigma_s);
     whole.SetTimeOffset(log.time_offset->estimate_s);
@@ -53,10 +55,50 @@ void Build(const MeasurementLog& log, const StartValue& start, const EstimatorOp
     if (log.time_offset) whole.SetCameraTiming(logged.id, logged.applied_offset_s, logged.velocity_px_s);
     previous = &s;
   }
-  for (const LoggedState& logged : log.states) {
-    AddStereoObservations(StereoFrame{logged.t_ns, logged.observations}, logged.id, options.model, whole);
+}
+
+Eigen::Isometry3d StartPose(const State& s) { return Eigen::Translation3d(s.p_w_b()) * s.q_w_b(); }
+
+// A landmark never estimated online: triangulated from all its views at the states' start values
+// (loose bounds: a start value, not a gate), else stereo-triangulated from the first view that allows it.
+std::optional<Eigen::Vector3d> Triangulated(const std::vector<std::pair<StateId, Eigen::Vector3d>>& views,
+                                            const ModelOptions& model, const Window& whole) {
+  std::vector<StereoView> stereo_views;
+  for (const auto& [state, z] : views) stereo_views.push_back({StartPose(whole.state(state)), z});
+  TriangulationOptions triangulation;
+  triangulation.pixel_sigma = model.pixel_sigma;
+  triangulation.max_reprojection_sigma = model.max_whitened_residual;
+  triangulation.max_position_sigma_m = model.max_depth_m;
+  const TriangulationResult result = TriangulateMultiView(stereo_views, whole.stereo(), triangulation);
+  if (result.p_w) return result.p_w;
+  for (const auto& [state, z] : views) {
+    const std::optional<Eigen::Vector3d> p_cl = TriangulateRectified(z, whole.stereo(), model.min_disparity_px);
+    if (p_cl && p_cl->z() <= model.max_depth_m) return StartPose(whole.state(state)) * whole.stereo().T_b_cl * *p_cl;
   }
-  whole.RefreshImuFactors(options.model.reintegrate_bias_threshold);
+  return std::nullopt;
+}
+
+// Every landmark at its last online estimate or triangulated, with all its observations.
+void AddLandmarks(const MeasurementLog& log, const LandmarkStarts& landmarks, const ModelOptions& model,
+                  Window& whole, RefinementReport& report) {
+  std::map<LandmarkId, std::vector<std::pair<StateId, Eigen::Vector3d>>> views;
+  for (const LoggedState& logged : log.states) {
+    for (const StereoObservation& obs : logged.observations) views[obs.landmark].emplace_back(logged.id, obs.z_px);
+  }
+  for (const auto& [id, seen] : views) {
+    const auto it = landmarks.find(id);
+    std::optional<Eigen::Vector3d> p_w;
+    if (it != landmarks.end()) {
+      p_w = it->second;
+      ++report.started_landmarks;
+    } else {
+      p_w = Triangulated(seen, model, whole);
+      if (p_w) ++report.triangulated_landmarks;
+    }
+    if (!p_w) continue;
+    whole.AddLandmark(id, *p_w);
+    for (const auto& [state, z] : seen) whole.AddObservation(state, id, z);
+  }
 }
 
 }  // namespace
@@ -77,12 +119,14 @@ SolveReport SolveWhole(Window& window, const EstimatorOptions& options) {
   return window.SolveSparse(solver);
 }
 
-RefinementReport Refine(const MeasurementLog& log, const StartValue& start, const EstimatorOptions& options,
-                        Window& whole) {
+RefinementReport Refine(const MeasurementLog& log, const StartValue& start, const LandmarkStarts& landmarks,
+                        const EstimatorOptions& options, Window& whole) {
   const auto begin = std::chrono::steady_clock::now();
   RefinementReport report;
   report.ran = true;
-  Build(log, start, options, whole);
+  AddStates(log, start, options, whole);
+  AddLandmarks(log, landmarks, options.model, whole, report);
+  whole.RefreshImuFactors(options.model.reintegrate_bias_threshold);
   // An observation that does not evaluate at the start values (a landmark at or behind a camera)
   // would fail the whole solve before its first iteration: dropped first, as a window's solve does.
   report.dropped_observations = whole.DropUnevaluableObservations();

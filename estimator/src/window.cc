@@ -277,7 +277,10 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
     removals_.leaving_states.push_back(states_.at(id));
     RemoveStateBookkeeping(id);
   }
-  for (LandmarkId id : landmark_ids) landmarks_.erase(id);
+  for (LandmarkId id : landmark_ids) {
+    removals_.leaving_landmarks.emplace_back(id, landmarks_.at(id).position());
+    landmarks_.erase(id);
+  }
   removals_.marginalized_states.insert(removals_.marginalized_states.end(), state_ids.begin(), state_ids.end());
   removals_.marginalized_landmarks.insert(removals_.marginalized_landmarks.end(), landmark_ids.begin(),
                                           landmark_ids.end());
@@ -386,6 +389,7 @@ void Window::DropLandmark(LandmarkId landmark_id) {
   auto it = landmarks_.find(landmark_id);
   CHECK(it != landmarks_.end()) << "dropping unknown landmark " << landmark_id.value;
   ForgetResidualsOf(LeavingOf({}, {landmark_id}));
+  removals_.leaving_landmarks.emplace_back(landmark_id, it->second.position());
   problem_->RemoveParameterBlock(it->second.p_w);
   landmarks_.erase(landmark_id);
   removals_.dropped_landmarks.push_back(landmark_id);

@@ -19,8 +19,8 @@ DEFINE_bool(output_observations, false,
 DEFINE_string(trajectory, "online",
               "which pose of each frame trajectory.txt and the evaluation hold: online (as estimated at that frame, "
               "what a real-time user gets) or smoothed (after the online pass, every frame refined by one global "
-              "solve of all states, landmarks and IMU factors started from each frame's last estimate: as it left "
-              "the window, or the local map's; its cost in summary.json's refinement and timing.csv's last line); "
+              "solve of all states, landmarks and IMU factors started from each frame's and landmark's last estimate: "
+              "as it left the window, or the local map's; its cost in summary.json's refinement and timing.csv's last line); "
               "batch writes its final solve either way {online|smoothed}");
 DEFINE_string(config, "", "run configuration YAML (e.g. config/euroc_stereo.yaml); flags override it");
 

@@ -51,6 +51,8 @@ std::string RefinementJson(const RefinementReport& r) {
   out << "{\"seconds\": " << JsonNumber(r.seconds) << ", \"iterations\": " << r.iterations
       << ", \"states\": " << r.states << ", \"landmarks\": " << r.landmarks
       << ", \"dropped_observations\": " << r.dropped_observations
+      << ", \"started_landmarks\": " << r.started_landmarks
+      << ", \"triangulated_landmarks\": " << r.triangulated_landmarks
       << ", \"initial_cost\": " << JsonNumber(r.initial_cost) << ", \"final_cost\": " << JsonNumber(r.final_cost)
       << ", \"usable\": " << (r.usable ? "true" : "false") << "}";
   return out.str();

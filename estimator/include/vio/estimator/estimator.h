@@ -93,7 +93,7 @@ class Estimator {
   /// now on, for Refine: call before the first frame.
   void KeepMeasurements() { log_.emplace(); }
   /// The offline refinement (refinement.h): every kept state, landmark and IMU factor solved together,
-  /// started from LastEstimates(). Nothing when no measurements were kept or the solve was unusable.
+  /// started from LastEstimates() and each landmark's last online estimate. Nothing when no measurements were kept or the solve was unusable.
   std::vector<FrameEstimate> Refine(RefinementReport* report) const;
 
   /// The body pose at t_ns predicted by the IMU from the newest state (for a

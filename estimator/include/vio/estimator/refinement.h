@@ -41,6 +41,8 @@ struct MeasurementLog {
   std::optional<Eigen::Matrix<double, 15, 15>> first_covariance;  ///< dynamic initialization
   std::vector<LoggedState> states;  ///< in time order
   std::optional<LoggedTimeOffset> time_offset;  ///< estimated online: estimated again, from its estimate
+  /// Each landmark's last online estimate as it left the window (marginalized or dropped) [m] (world).
+  std::map<LandmarkId, Eigen::Vector3d> landmarks;
 };
 
 /// The cost of one refinement (summary.json, timing.csv).
@@ -51,6 +53,8 @@ struct RefinementReport {
   int states = 0;
   int landmarks = 0;
   int dropped_observations = 0;  ///< observations that did not evaluate at the start values: dropped before the solve
+  int started_landmarks = 0;      ///< landmarks started at their last online estimate
+  int triangulated_landmarks = 0; ///< landmarks never estimated online: triangulated from all their observations
   double initial_cost = 0;
   double final_cost = 0;
   bool usable = false;
@@ -68,10 +72,14 @@ SolveReport SolveWhole(Window& window, const EstimatorOptions& options);
 /// state is then predicted by the IMU from the previous one).
 using StartValue = std::function<bool(const LoggedState& logged, State* state)>;
 
-/// Builds the whole problem of `log` in `whole` (an empty window), each state at its start value and
-/// each landmark stereo-triangulated from the first state that sees it, and the time offset (when
-/// logged) at its online estimate under its prior, and solves it (SolveWhole).
-RefinementReport Refine(const MeasurementLog& log, const StartValue& start, const EstimatorOptions& options,
-                        Window& whole);
+/// Start values of landmarks: each one's last online estimate [m] (world).
+using LandmarkStarts = std::map<LandmarkId, Eigen::Vector3d>;
+
+/// Builds the whole problem of `log` in `whole` (an empty window), each state at its start value, each
+/// landmark at its start in `landmarks` or else triangulated from all its observations at the states'
+/// start values (or, when that fails, stereo-triangulated from the first observation that allows it),
+/// and the time offset (when logged) at its online estimate under its prior, and solves it (SolveWhole).
+RefinementReport Refine(const MeasurementLog& log, const StartValue& start, const LandmarkStarts& landmarks,
+                        const EstimatorOptions& options, Window& whole);
 
 }  // namespace vio

@@ -17,6 +17,7 @@
 #include <set>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <ceres/ceres.h>
@@ -81,6 +82,8 @@ struct Removals {
   std::vector<StateId> dropped_states;
   std::vector<LandmarkId> dropped_landmarks;  ///< incl. those a dropped state left unobserved
   std::vector<State> leaving_states;  ///< the marginalized and dropped states, as last estimated
+  /// The marginalized and dropped landmarks' positions as last estimated [m] (world).
+  std::vector<std::pair<LandmarkId, Eigen::Vector3d>> leaving_landmarks;
 };
 
 /// What went wrong in the window and was survived, counted over its life.
