@@ -1,6 +1,7 @@
 #include "vio/marginalization/marginalizer.h"
 
 #include <algorithm>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <unordered_map>
@@ -160,19 +161,27 @@ int TangentDim(const ceres::Problem& problem, const std::vector<double*>& blocks
 /// Schur-complemented out block by block: the assembly the Gauss-Newton step
 /// uses (BlockSystem; earlier priors from their information, loss functions
 /// as Ceres applies them).
-NormalEquations ReducedBlanket(ceres::Problem* problem, const MarkovBlanket& blanket, const RankThreshold& threshold) {
+NormalEquations ReducedBlanket(ceres::Problem* problem, const MarkovBlanket& blanket,
+                               const MarginalizationOptions& options) {
   BlockLayout layout;
   layout.dense = blanket.kept;
   layout.dense.insert(layout.dense.end(), blanket.marg_dense.begin(), blanket.marg_dense.end());
   layout.eliminated = blanket.marg_uncoupled;
   layout.residuals = blanket.residual_blocks;
-  BlockSystem system(problem, std::move(layout), threshold);
+  std::optional<BlockSystem> own;
+  BlockSystem* system = options.system;
+  if (system != nullptr) {
+    CHECK(system->problem() == problem) << "marginalization: a kept system of another problem";
+    system->Relayout(std::move(layout), options.rank_threshold);
+  } else {
+    system = &own.emplace(problem, std::move(layout), options.rank_threshold);
+  }
   double cost = 0.0;
-  if (!system.Reduce(&cost)) {
+  if (!system->Reduce(&cost)) {
     throw std::runtime_error("marginalization: the Markov blanket's residuals do not evaluate (or are not finite)");
   }
   NormalEquations reduced;
-  system.MoveReducedTo(&reduced.H, &reduced.b);
+  system->MoveReducedTo(&reduced.H, &reduced.b);
   return reduced;
 }
 
@@ -219,7 +228,7 @@ std::unique_ptr<MarginalizationPrior> BuildPrior(ceres::Problem* problem,
   const RankThreshold& threshold = options.rank_threshold;
   const int keep_dim = TangentDim(*problem, blanket.kept);
   const int dense_dim = TangentDim(*problem, blanket.marg_dense);
-  const NormalEquations without_uncoupled = ReducedBlanket(problem, blanket, threshold);
+  const NormalEquations without_uncoupled = ReducedBlanket(problem, blanket, options);
   const NormalEquations marginal =
       SchurComplement(without_uncoupled.H, without_uncoupled.b, keep_dim, dense_dim, threshold);
   SqrtInformation sqrt =

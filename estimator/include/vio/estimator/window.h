@@ -29,6 +29,7 @@
 #include "vio/estimator/imu_preintegration.h"
 #include "vio/estimator/solve_control.h"
 #include "vio/estimator/types.h"
+#include "vio/marginalization/block_system.h"
 #include "vio/marginalization/marginalizer.h"
 
 namespace vio {
@@ -392,6 +393,8 @@ class Window {
   /// The exact Gauss-Newton path's solver, re-laid out for every solve: its
   /// buffers (a window's normal equations, a few MB) are reused frame after frame.
   std::unique_ptr<GaussNewtonSolver> gauss_newton_;
+  /// The marginalizations' assembly, kept likewise (MarginalizationOptions::system).
+  std::unique_ptr<marginalization::BlockSystem> marginal_system_;
 };
 
 }  // namespace vio
