@@ -85,6 +85,16 @@ struct Removals {
   std::vector<State> leaving_states;  ///< the marginalized and dropped states, as last estimated
   /// The marginalized and dropped landmarks' positions as last estimated [m] (world).
   std::vector<std::pair<LandmarkId, Eigen::Vector3d>> leaving_landmarks;
+
+  /// Empties every list, keeping their memory for the next frame's.
+  void Clear() {
+    marginalized_states.clear();
+    marginalized_landmarks.clear();
+    dropped_states.clear();
+    dropped_landmarks.clear();
+    leaving_states.clear();
+    leaving_landmarks.clear();
+  }
 };
 
 /// What went wrong in the window and was survived, counted over its life.
@@ -231,7 +241,7 @@ class Window {
   /// What was removed since the last ClearRemovals (the estimator clears it
   /// every frame; the structural policy tests read it).
   const Removals& removals() const { return removals_; }
-  void ClearRemovals() { removals_ = Removals(); }
+  void ClearRemovals() { removals_.Clear(); }
 
   // ---- queries ---------------------------------------------------------------
   const std::map<StateId, State>& states() const { return states_; }
