@@ -255,6 +255,10 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   marginalization::MarginalizationOptions options;
   options.residual_order = ResidualOrderOf(leaving);
   options.kept_order = StateColumnOrder();
+  if (marginal_system_ == nullptr) {
+    marginal_system_ = std::make_unique<marginalization::BlockSystem>(problem_.get(), marginalization::BlockLayout{});
+  }
+  options.system = marginal_system_.get();
   // Rank-deficient priors come in runs: after one, no unpivoted attempt at the
   // next square root (a whole factorization that would fail its pivot test).
   if (last_prior_rank_deficient_) options.sqrt_method = marginalization::SqrtMethod::kPivotedCholeskyOnly;

@@ -37,8 +37,7 @@ void BlockSystem::Impl::Build(BlockLayout l) {
     index[layout.dense[k]].dense = static_cast<int>(k);
   }
   int col = dense_dim;
-  eliminated.resize(layout.eliminated.size());
-  for (EliminatedBlock& block : eliminated) block.coupled.clear();
+  ResizeEliminated(layout.eliminated.size());
   for (size_t k = 0; k < layout.eliminated.size(); ++k) {
     eliminated[k].columns = {col, problem->ParameterBlockTangentSize(layout.eliminated[k])};
     col += eliminated[k].columns.size;
@@ -70,7 +69,7 @@ void BlockSystem::Impl::Build(BlockLayout l) {
   for (EliminatedBlock& block : eliminated) {
     std::sort(block.coupled.begin(), block.coupled.end());
     block.coupled.erase(std::unique(block.coupled.begin(), block.coupled.end()), block.coupled.end());
-    block.W.resize(block.coupled.size());
+    if (block.W.size() < block.coupled.size()) block.W.resize(block.coupled.size());  // extra ones unused, kept
   }
   for (Residual& residual : residuals) {
     if (residual.eliminated < 0) continue;
@@ -82,6 +81,24 @@ void BlockSystem::Impl::Build(BlockLayout l) {
   }
   jacobians.resize(scratch);
   structure_found = false;
+}
+
+// `count` eliminated blocks, those beyond it kept aside with their buffers
+// (a marginalization's system is re-laid out for a different count each time).
+void BlockSystem::Impl::ResizeEliminated(size_t count) {
+  while (eliminated.size() > count) {
+    spare_eliminated.push_back(std::move(eliminated.back()));
+    eliminated.pop_back();
+  }
+  while (eliminated.size() < count) {
+    if (spare_eliminated.empty()) {
+      eliminated.emplace_back();
+    } else {
+      eliminated.push_back(std::move(spare_eliminated.back()));
+      spare_eliminated.pop_back();
+    }
+  }
+  for (EliminatedBlock& block : eliminated) block.coupled.clear();
 }
 
 // The residual's slots; returns the scratch its tangent Jacobians and its
@@ -120,7 +137,8 @@ std::pair<size_t, size_t> BlockSystem::Impl::AddResidual(ceres::ResidualBlockId 
       if (slot.dense >= 0) eliminated[residual.eliminated].coupled.push_back(slot.dense);
     }
   }
-  if (residual.loss == nullptr) {  // with a loss, as any other residual
+  // With a loss, as any other residual; a prior gives no tangent Jacobians itself.
+  if (residual.loss == nullptr && residual.on_tangents == nullptr) {
     residual.prior = dynamic_cast<const MarginalizationPrior*>(cost);
   }
   r.resize(std::max(r.size(), static_cast<size_t>(residual.rows)));
@@ -136,10 +154,10 @@ std::pair<size_t, size_t> BlockSystem::Impl::AddResidual(ceres::ResidualBlockId 
 /// pair by pair when the span is mostly gaps) and b -= U S^T b_e.
 void BlockSystem::Impl::Eliminate() {
   pending.clear();
-  for (size_t k = 0; k < eliminated.size(); ++k) {
-    EliminatedBlock& block = eliminated[k];
-    block.H_inv = PseudoInverse(block.H, threshold);
-    const Eigen::LLT<Eigen::MatrixXd> factor(block.H_inv);
+  pending_u_used = 0;
+  for (EliminatedBlock& block : eliminated) {
+    PseudoInverseInto(block.H, threshold, &block.H_inv);
+    factor.compute(block.H_inv);
     if (factor.info() != Eigen::Success) {  // H_inv singular (rank-truncated): no square root
       EliminatePairwise(block);
       continue;
@@ -153,21 +171,14 @@ void BlockSystem::Impl::Eliminate() {
     int rows = 0;
     for (const int d : block.coupled) rows += dense[d].size;
     const bool contiguous = span <= 2 * rows;
-    StackCouplings(block, contiguous ? first : -1, contiguous ? span : rows);
-    if (U.cols() == 3) {  // a landmark: the 3x3 factor on fixed-size, coefficient by coefficient
-      const Eigen::Matrix3d L = factor.matrixL();
-      UL.noalias() = U.lazyProduct(L);
-      U.swap(UL);
-    } else {
-      U = U * factor.matrixL();
-    }
-    const Eigen::VectorXd c = factor.matrixU() * block.b;
+    const Eigen::Map<Eigen::MatrixXd> U =
+        TimesFactor(StackCouplings(block, contiguous ? first : -1, contiguous ? span : rows));
+    c.noalias() = factor.matrixU() * block.b;
     if (contiguous) {
       b.segment(first, span).noalias() -= U * c;
-      block.U = U;
-      pending.push_back({first, span, static_cast<int>(k)});
+      KeepPendingUpdate(first, U);
     } else {
-      SubtractPackedUpdate(block, c);
+      SubtractPackedUpdate(block, U);
     }
   }
   SubtractPendingUpdates();
@@ -176,23 +187,57 @@ void BlockSystem::Impl::Eliminate() {
 // U = the block's couplings W stacked: at their columns' offsets from
 // `first` over `rows` rows (zero rows in the gaps), or packed one after the
 // other when `first` is -1.
-void BlockSystem::Impl::StackCouplings(const EliminatedBlock& block, int first, int rows) {
-  if (first >= 0) {
-    U.setZero(rows, block.columns.size);
-  } else {
-    U.resize(rows, block.columns.size);
-  }
+Eigen::Map<Eigen::MatrixXd> BlockSystem::Impl::StackCouplings(const EliminatedBlock& block, int first, int rows) {
+  const auto size = static_cast<size_t>(rows) * static_cast<size_t>(block.columns.size);
+  if (u_buffer.size() < size) u_buffer.resize(size);
+  Eigen::Map<Eigen::MatrixXd> U(u_buffer.data(), rows, block.columns.size);
+  if (first >= 0) U.setZero();
   for (size_t p = 0, packed = 0; p < block.coupled.size(); packed += block.W[p].rows(), ++p) {
     const Eigen::Index row = first >= 0 ? dense[block.coupled[p]].offset - first : static_cast<Eigen::Index>(packed);
     U.middleRows(row, block.W[p].rows()) = block.W[p];
   }
+  return U;
 }
+
+// U times the lower factor of the block's H_inv (in place, or into ul_buffer).
+Eigen::Map<Eigen::MatrixXd> BlockSystem::Impl::TimesFactor(Eigen::Map<Eigen::MatrixXd> U) {
+  if (U.cols() != 3) {
+    U = U * factor.matrixL();
+    return U;
+  }
+  // A landmark: the 3x3 factor on fixed-size, coefficient by coefficient.
+  const Eigen::Matrix3d L = factor.matrixL();
+  if (ul_buffer.size() < static_cast<size_t>(U.size())) ul_buffer.resize(static_cast<size_t>(U.size()));
+  Eigen::Map<Eigen::MatrixXd> UL(ul_buffer.data(), U.rows(), 3);
+  UL.noalias() = U.lazyProduct(L);
+  return UL;
+}
+
+// U kept for SubtractPendingUpdates, after the earlier blocks' in pending_u.
+void BlockSystem::Impl::KeepPendingUpdate(int first, const Eigen::Map<Eigen::MatrixXd>& U) {
+  const auto size = static_cast<size_t>(U.size());
+  if (pending_u.size() < pending_u_used + size) pending_u.resize(pending_u_used + size);
+  std::copy(U.data(), U.data() + size, pending_u.begin() + static_cast<std::ptrdiff_t>(pending_u_used));
+  pending.push_back({first, static_cast<int>(U.rows()), static_cast<int>(U.cols()), pending_u_used});
+  pending_u_used += size;
+}
+
+namespace {
+
+// column[i] -= u0[i] v0 + u1[i] v1 + u2[i] v2 for i < rows, summed in that
+// order from zero as SubtractPackedUpdate's loop over U's columns sums it.
+void SubtractProducts3(const double* u0, const double* u1, const double* u2, double v0, double v1, double v2,
+                       int rows, double* column) {
+  for (int i = 0; i < rows; ++i) column[i] -= ((0.0 + u0[i] * v0) + u1[i] * v1) + u2[i] * v2;
+}
+
+}  // namespace
 
 // b -= U c and H -= U U^T block pair by block pair, U packed (StackCouplings).
 // Each entry of U U^T is summed over U's columns in order from zero, as the
 // blocked rank update summed it into a zeroed buffer: the same values,
 // without an n x n buffer to clear and scatter for each block.
-void BlockSystem::Impl::SubtractPackedUpdate(const EliminatedBlock& block, const Eigen::VectorXd& c) {
+void BlockSystem::Impl::SubtractPackedUpdate(const EliminatedBlock& block, const Eigen::Map<Eigen::MatrixXd>& U) {
   for (size_t p = 0, rp = 0; p < block.coupled.size(); rp += dense[block.coupled[p]].size, ++p) {
     const Columns& a = dense[block.coupled[p]];
     b.segment(a.offset, a.size).noalias() -= U.middleRows(rp, a.size) * c;
@@ -206,6 +251,10 @@ void BlockSystem::Impl::SubtractPackedUpdate(const EliminatedBlock& block, const
         // Within a diagonal block only its upper triangle (the rank update's).
         const int rows = p == q ? j + 1 : a.size;
         double* column = &H(a.offset, c2.offset + j);
+        if (depth == 3) {  // a landmark's: the same sums, one vectorizable pass over the rows
+          SubtractProducts3(&U(rp, 0), &U(rp, 1), &U(rp, 2), U(rq + j, 0), U(rq + j, 1), U(rq + j, 2), rows, column);
+          continue;
+        }
         for (int i = 0; i < rows; ++i) {
           double sum = 0.0;
           for (Eigen::Index k = 0; k < depth; ++k) sum += U(rp + i, k) * U(rq + j, k);
@@ -231,7 +280,7 @@ void BlockSystem::Impl::SubtractPendingUpdates() {
     Eigen::Index columns = 0;
     for (end = begin; end < pending.size() && pending[end].first == group.first && pending[end].rows == group.rows;
          ++end) {
-      columns += eliminated[pending[end].block].U.cols();
+      columns += pending[end].cols;
     }
     // Mapped on a buffer that only grows: the groups' sizes vary, and a
     // matrix resized for each would reallocate (and page-fault) every time.
@@ -240,7 +289,7 @@ void BlockSystem::Impl::SubtractPendingUpdates() {
     Eigen::Map<Eigen::MatrixXd> stacked_columns(stacked.data(), group.rows, columns);
     columns = 0;
     for (size_t k = begin; k < end; ++k) {
-      const Eigen::MatrixXd& u = eliminated[pending[k].block].U;
+      const Eigen::Map<const Eigen::MatrixXd> u(pending_u.data() + pending[k].offset, group.rows, pending[k].cols);
       stacked_columns.middleCols(columns, u.cols()) = u;
       columns += u.cols();
     }
@@ -363,6 +412,11 @@ BlockSystem::BlockSystem(ceres::Problem* problem, BlockLayout layout, const Rank
 BlockSystem::~BlockSystem() = default;
 
 void BlockSystem::Relayout(BlockLayout layout) { impl_->Build(std::move(layout)); }
+void BlockSystem::Relayout(BlockLayout layout, const RankThreshold& threshold) {
+  impl_->threshold = threshold;
+  impl_->Build(std::move(layout));
+}
+ceres::Problem* BlockSystem::problem() const { return impl_->problem; }
 
 bool BlockSystem::Reduce(double* cost) { return impl_->Reduce(cost); }
 const Eigen::MatrixXd& BlockSystem::H() const { return impl_->H; }

@@ -12,6 +12,7 @@
 #include <ceres/loss_function.h>
 #include <ceres/manifold.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include "vio/marginalization/block_system.h"
@@ -80,7 +81,6 @@ struct EliminatedBlock {
   Eigen::VectorXd b;               ///< J_e^T r
   std::vector<Eigen::MatrixXd> W;  ///< J_d^T J_e per coupled dense block
   Eigen::MatrixXd H_inv;           ///< (pseudo-)inverse of H
-  Eigen::MatrixXd U;               ///< its Schur update is -U U^T on contiguous coupled columns
 };
 
 /// A block of H's upper block triangle: rows of one dense block, columns of another.
@@ -95,7 +95,8 @@ struct Rectangle {
 struct PendingUpdate {
   int first = 0;
   int rows = 0;
-  int block = 0;  ///< the eliminated block holding U
+  int cols = 0;        ///< U's columns
+  size_t offset = 0;   ///< where U (rows x cols, column-major) starts in Impl::pending_u
 };
 
 }  // namespace block_system_detail
@@ -119,6 +120,8 @@ struct BlockSystem::Impl {
   std::vector<Columns> dense;
   int dense_dim = 0;
   std::vector<EliminatedBlock> eliminated;
+  /// Blocks a smaller layout left, their buffers kept for a larger one.
+  std::vector<EliminatedBlock> spare_eliminated;
   std::vector<Residual> residuals;
   std::vector<double*> residual_values;  ///< every residual's parameter blocks, one after the other
   std::vector<Slot> residual_slots;      ///< every residual's slots, one after the other
@@ -146,19 +149,30 @@ struct BlockSystem::Impl {
   std::vector<std::pair<const ceres::Manifold*, const double*>> manifold_blocks;
   MarginalizationPrior::TangentLinearization prior_linearization;
   Eigen::MatrixXd prior_part;  ///< one block of a prior's J^T J
-  Eigen::MatrixXd U;
-  /// Contiguous Schur updates waiting to be applied (SubtractPendingUpdates).
+  // An eliminated block's Schur update (Eliminate), on buffers that only grow:
+  // the sizes change from block to block, and a matrix resized for each would
+  // reallocate every time.
+  Eigen::LLT<Eigen::MatrixXd> factor;  ///< of its H_inv
+  Eigen::VectorXd c;                   ///< factor.matrixU() b_e
+  std::vector<double> u_buffer;        ///< its couplings stacked (StackCouplings), times the factor
+  std::vector<double> ul_buffer;
+  /// Contiguous Schur updates waiting to be applied (SubtractPendingUpdates),
+  /// their U one after the other in `pending_u` (the first `pending_u_used`).
   std::vector<PendingUpdate> pending;
+  std::vector<double> pending_u;
+  size_t pending_u_used = 0;
   std::vector<double> stacked;  ///< a group's U side by side (SubtractPendingUpdates)
-  Eigen::MatrixXd UL;
 
   // block_system.cc: structure, elimination, back-substitution, cost.
   Impl(ceres::Problem* p, BlockLayout l, const RankThreshold& t);
   void Build(BlockLayout l);
   std::pair<size_t, size_t> AddResidual(ceres::ResidualBlockId id, const std::unordered_map<const double*, Slot>& index);
   void Eliminate();
-  void StackCouplings(const EliminatedBlock& block, int first, int rows);
-  void SubtractPackedUpdate(const EliminatedBlock& block, const Eigen::VectorXd& c);
+  void ResizeEliminated(size_t count);
+  Eigen::Map<Eigen::MatrixXd> StackCouplings(const EliminatedBlock& block, int first, int rows);
+  Eigen::Map<Eigen::MatrixXd> TimesFactor(Eigen::Map<Eigen::MatrixXd> U);
+  void KeepPendingUpdate(int first, const Eigen::Map<Eigen::MatrixXd>& U);
+  void SubtractPackedUpdate(const EliminatedBlock& block, const Eigen::Map<Eigen::MatrixXd>& U);
   void SubtractPendingUpdates();
   void EliminatePairwise(const EliminatedBlock& block);
   bool Reduce(double* cost);

@@ -308,6 +308,14 @@ Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& H, const RankThreshold& thr
          eig.eigenvectors.transpose();
 }
 
+void PseudoInverseInto(const Eigen::MatrixXd& H, const RankThreshold& threshold, Eigen::MatrixXd* H_inv) {
+  if (H.rows() == 3 && H.cols() == 3 && H.allFinite()) {
+    *H_inv = PseudoInverse3(H, threshold);
+  } else {
+    *H_inv = PseudoInverse(H, threshold);
+  }
+}
+
 NormalEquations SchurComplement(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, int keep_dim,
                                 int marg_dim, const RankThreshold& threshold) {
   RequireSizes(H, b, keep_dim, marg_dim, "SchurComplement");

@@ -1,6 +1,7 @@
 #include "vio/marginalization/marginalizer.h"
 
 #include <algorithm>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <unordered_map>
@@ -71,25 +72,44 @@ std::vector<ceres::ResidualBlockId> ResidualBlocksTouching(const ceres::Problem&
   return ordered;
 }
 
+/// Which marginalized blocks share a residual block: for marginalized block k
+/// (its index in `marg`), its neighbours are neighbours[offsets[k]] up to
+/// neighbours[offsets[k + 1]] (repeats possible). Flat arrays, no set per block.
+struct Couplings {
+  std::vector<int> offsets;
+  std::vector<int> neighbours;
+
+  /// From the coupled pairs (each in both directions).
+  Couplings(size_t blocks, std::vector<std::pair<int, int>> pairs) : offsets(blocks + 1, 0) {
+    std::sort(pairs.begin(), pairs.end());
+    neighbours.reserve(pairs.size());
+    for (const auto& [from, to] : pairs) {
+      ++offsets[static_cast<size_t>(from) + 1];
+      neighbours.push_back(to);
+    }
+    for (size_t k = 0; k < blocks; ++k) offsets[k + 1] += offsets[k];
+  }
+};
+
 /// Greedy independent set of the coupling graph (two marginalized blocks are
 /// coupled when a residual block touches both), smallest blocks first so the
-/// landmarks of a marginalized frame are eliminated one by one.
-void SplitMarginalized(const ceres::Problem& problem, const std::vector<double*>& marg_variable,
-                       const std::unordered_map<const double*, BlockSet>& coupled,
-                       MarkovBlanket* blanket) {
-  std::vector<double*> by_size = marg_variable;
-  std::stable_sort(by_size.begin(), by_size.end(), [&problem](double* a, double* b) {
-    return problem.ParameterBlockTangentSize(a) < problem.ParameterBlockTangentSize(b);
-  });
-  BlockSet picked;
-  for (double* block : by_size) {
-    const auto neighbours = coupled.find(block);
-    const bool independent =
-        neighbours == coupled.end() ||
-        std::none_of(neighbours->second.begin(), neighbours->second.end(),
-                     [&picked](const double* other) { return picked.count(other) > 0; });
+/// landmarks of a marginalized frame are eliminated one by one. `marg_variable`:
+/// indices into `marg`.
+void SplitMarginalized(const ceres::Problem& problem, const std::vector<double*>& marg,
+                       const std::vector<int>& marg_variable, const Couplings& coupled, MarkovBlanket* blanket) {
+  std::vector<std::pair<int, int>> by_size;  // (tangent size, index)
+  by_size.reserve(marg_variable.size());
+  for (const int k : marg_variable) by_size.emplace_back(problem.ParameterBlockTangentSize(marg[static_cast<size_t>(k)]), k);
+  std::stable_sort(by_size.begin(), by_size.end(),
+                   [](const std::pair<int, int>& a, const std::pair<int, int>& b) { return a.first < b.first; });
+  std::vector<char> picked(marg.size(), 0);
+  for (const auto& [size, k] : by_size) {
+    const auto first = coupled.neighbours.begin() + coupled.offsets[static_cast<size_t>(k)];
+    const auto last = coupled.neighbours.begin() + coupled.offsets[static_cast<size_t>(k) + 1];
+    const bool independent = std::none_of(first, last, [&picked](int other) { return picked[static_cast<size_t>(other)] != 0; });
+    double* block = marg[static_cast<size_t>(k)];
     if (independent) {
-      picked.insert(block);
+      picked[static_cast<size_t>(k)] = 1;
       blanket->marg_uncoupled.push_back(block);
     } else {
       blanket->marg_dense.push_back(block);
@@ -114,36 +134,38 @@ MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector
                                 const MarginalizationOptions& options) {
   MarkovBlanket blanket;
   blanket.residual_blocks = ResidualBlocksTouching(problem, marg, options.residual_order);
-  const BlockSet marg_set(marg.begin(), marg.end());
+  std::unordered_map<const double*, int> marg_index;
+  marg_index.reserve(marg.size());
+  for (size_t k = 0; k < marg.size(); ++k) marg_index.emplace(marg[k], static_cast<int>(k));
   BlockSet kept_seen;
-  std::unordered_map<const double*, BlockSet> coupled;
+  std::vector<std::pair<int, int>> pairs;
   std::vector<double*> touched;
+  std::vector<int> marg_here;
   for (const ceres::ResidualBlockId residual_block : blanket.residual_blocks) {
     problem.GetParameterBlocksForResidualBlock(residual_block, &touched);
-    std::vector<double*> marg_here;
+    marg_here.clear();
     for (double* block : touched) {
       if (!IsVariable(problem, block)) {
         continue;
       }
-      if (marg_set.count(block) > 0) {
-        marg_here.push_back(block);
+      if (const auto it = marg_index.find(block); it != marg_index.end()) {
+        marg_here.push_back(it->second);
       } else if (kept_seen.insert(block).second) {
         blanket.kept.push_back(block);
       }
     }
-    for (double* a : marg_here) {
-      for (double* b : marg_here) {
-        if (a != b) {
-          coupled[a].insert(b);
-        }
+    for (const int a : marg_here) {
+      for (const int b : marg_here) {
+        if (a != b) pairs.emplace_back(a, b);
       }
     }
   }
   OrderKept(options.kept_order, &blanket.kept);
-  std::vector<double*> marg_variable;
-  std::copy_if(marg.begin(), marg.end(), std::back_inserter(marg_variable),
-               [&problem](double* block) { return IsVariable(problem, block); });
-  SplitMarginalized(problem, marg_variable, coupled, &blanket);
+  std::vector<int> marg_variable;
+  for (size_t k = 0; k < marg.size(); ++k) {
+    if (IsVariable(problem, marg[k])) marg_variable.push_back(static_cast<int>(k));
+  }
+  SplitMarginalized(problem, marg, marg_variable, Couplings(marg.size(), std::move(pairs)), &blanket);
   return blanket;
 }
 
@@ -160,19 +182,27 @@ int TangentDim(const ceres::Problem& problem, const std::vector<double*>& blocks
 /// Schur-complemented out block by block: the assembly the Gauss-Newton step
 /// uses (BlockSystem; earlier priors from their information, loss functions
 /// as Ceres applies them).
-NormalEquations ReducedBlanket(ceres::Problem* problem, const MarkovBlanket& blanket, const RankThreshold& threshold) {
+NormalEquations ReducedBlanket(ceres::Problem* problem, const MarkovBlanket& blanket,
+                               const MarginalizationOptions& options) {
   BlockLayout layout;
   layout.dense = blanket.kept;
   layout.dense.insert(layout.dense.end(), blanket.marg_dense.begin(), blanket.marg_dense.end());
   layout.eliminated = blanket.marg_uncoupled;
   layout.residuals = blanket.residual_blocks;
-  BlockSystem system(problem, std::move(layout), threshold);
+  std::optional<BlockSystem> own;
+  BlockSystem* system = options.system;
+  if (system != nullptr) {
+    CHECK(system->problem() == problem) << "marginalization: a kept system of another problem";
+    system->Relayout(std::move(layout), options.rank_threshold);
+  } else {
+    system = &own.emplace(problem, std::move(layout), options.rank_threshold);
+  }
   double cost = 0.0;
-  if (!system.Reduce(&cost)) {
+  if (!system->Reduce(&cost)) {
     throw std::runtime_error("marginalization: the Markov blanket's residuals do not evaluate (or are not finite)");
   }
   NormalEquations reduced;
-  system.MoveReducedTo(&reduced.H, &reduced.b);
+  system->MoveReducedTo(&reduced.H, &reduced.b);
   return reduced;
 }
 
@@ -219,7 +249,7 @@ std::unique_ptr<MarginalizationPrior> BuildPrior(ceres::Problem* problem,
   const RankThreshold& threshold = options.rank_threshold;
   const int keep_dim = TangentDim(*problem, blanket.kept);
   const int dense_dim = TangentDim(*problem, blanket.marg_dense);
-  const NormalEquations without_uncoupled = ReducedBlanket(problem, blanket, threshold);
+  const NormalEquations without_uncoupled = ReducedBlanket(problem, blanket, options);
   const NormalEquations marginal =
       SchurComplement(without_uncoupled.H, without_uncoupled.b, keep_dim, dense_dim, threshold);
   SqrtInformation sqrt =

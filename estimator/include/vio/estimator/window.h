@@ -29,6 +29,7 @@
 #include "vio/estimator/imu_preintegration.h"
 #include "vio/estimator/solve_control.h"
 #include "vio/estimator/types.h"
+#include "vio/marginalization/block_system.h"
 #include "vio/marginalization/marginalizer.h"
 
 namespace vio {
@@ -84,6 +85,16 @@ struct Removals {
   std::vector<State> leaving_states;  ///< the marginalized and dropped states, as last estimated
   /// The marginalized and dropped landmarks' positions as last estimated [m] (world).
   std::vector<std::pair<LandmarkId, Eigen::Vector3d>> leaving_landmarks;
+
+  /// Empties every list, keeping their memory for the next frame's.
+  void Clear() {
+    marginalized_states.clear();
+    marginalized_landmarks.clear();
+    dropped_states.clear();
+    dropped_landmarks.clear();
+    leaving_states.clear();
+    leaving_landmarks.clear();
+  }
 };
 
 /// What went wrong in the window and was survived, counted over its life.
@@ -230,7 +241,7 @@ class Window {
   /// What was removed since the last ClearRemovals (the estimator clears it
   /// every frame; the structural policy tests read it).
   const Removals& removals() const { return removals_; }
-  void ClearRemovals() { removals_ = Removals(); }
+  void ClearRemovals() { removals_.Clear(); }
 
   // ---- queries ---------------------------------------------------------------
   const std::map<StateId, State>& states() const { return states_; }
@@ -392,6 +403,8 @@ class Window {
   /// The exact Gauss-Newton path's solver, re-laid out for every solve: its
   /// buffers (a window's normal equations, a few MB) are reused frame after frame.
   std::unique_ptr<GaussNewtonSolver> gauss_newton_;
+  /// The marginalizations' assembly, kept likewise (MarginalizationOptions::system).
+  std::unique_ptr<marginalization::BlockSystem> marginal_system_;
 };
 
 }  // namespace vio

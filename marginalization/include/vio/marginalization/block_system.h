@@ -52,6 +52,9 @@ class BlockSystem {
   /// buffers: no reallocation, and no fresh pages to fault in, when the sizes
   /// repeat.
   void Relayout(BlockLayout layout);
+  /// The same with another rank threshold (a marginalization's kept system).
+  void Relayout(BlockLayout layout, const RankThreshold& threshold);
+  ceres::Problem* problem() const;
 
   /// Assembles at the current values and eliminates; `cost` = 1/2 sum rho(|r|^2).
   /// False when a residual does not evaluate or gives a non-finite value.

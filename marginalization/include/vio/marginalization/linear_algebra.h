@@ -71,6 +71,9 @@ struct SqrtInformation {
 /// Pseudo-inverse of a symmetric PSD matrix via its eigen-decomposition;
 /// eigenvalues at or below `threshold` are treated as zero.
 Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& H, const RankThreshold& threshold = {});
+/// PseudoInverse into `H_inv` (the same values); for a 3x3 H (a landmark's
+/// block) without a heap allocation once H_inv has that size.
+void PseudoInverseInto(const Eigen::MatrixXd& H, const RankThreshold& threshold, Eigen::MatrixXd* H_inv);
 
 /// Schur complement that removes the trailing `marg_dim` variables of (H, b):
 /// H is (keep_dim + marg_dim) square, kept variables first. Throws

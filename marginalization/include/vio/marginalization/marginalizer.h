@@ -30,6 +30,8 @@
 
 namespace vio::marginalization {
 
+class BlockSystem;
+
 struct MarginalizationOptions {
   /// Eigenvalues of H_MM (when pseudo-inverting it) and eigenvalues / pivots
   /// of the marginal H* (when taking its square root) below this are zero.
@@ -57,6 +59,9 @@ struct MarginalizationOptions {
   /// then mostly one contiguous range, and its Schur update one rank update in
   /// place.
   std::vector<const double*> kept_order;
+  /// A system of the same problem to assemble in (re-laid out, its buffers
+  /// reused from one marginalization to the next), or nullptr for a new one.
+  BlockSystem* system = nullptr;
 };
 
 struct MarginalizationResult {
