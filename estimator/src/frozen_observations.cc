@@ -149,11 +149,11 @@ Eigen::Matrix<double, 15, 1> Window::StateStep(StateId id) {
     }
     double cost = 0;
     if (!problem_->EvaluateResidualBlock(residual, true, &cost, r.data(), jacobians.data()) || !r.allFinite()) continue;
-    Eigen::MatrixXd j(rows, 15);
+    Eigen::Matrix<double, Eigen::Dynamic, 15> j(rows, 15);
     j << j_pose, j_speed_bias;
     if (!j.allFinite()) continue;
-    h += j.transpose() * j;
-    g += j.transpose() * r;
+    h.noalias() += j.transpose() * j;
+    g.noalias() += j.transpose() * r;
   }
   SetStateConstant(id, was_constant);
   const Eigen::Matrix<double, 15, 1> step = h.ldlt().solve(-g);

@@ -171,7 +171,7 @@ struct BatchOptions {
 struct SmootherOptions {
   int smoother_active_states = 10;             ///< newest states solved every frame [frames]
   double smoother_relinearize_threshold = 1e-3;  ///< an older state's pending step that frees it [m or rad]
-  int smoother_checks_per_frame = 20;          ///< older states whose pending step is checked per frame [count]
+  int smoother_checks_per_frame = 4;           ///< older states whose pending step is checked per frame [count]
   int smoother_full_every = 0;                 ///< every this many frames every state is solved; 0 = never [frames]
 
   template <class V>
