@@ -54,6 +54,17 @@ void AddToSummary(const Eigen::Vector3d& p, double f, const Eigen::Vector3d& g, 
   ++summary.observations;
 }
 
+void RemoveFromSummary(const SummarizedObservation& o, FrozenObservations& frozen) {
+  const auto it = frozen.landmarks.find(o.landmark);
+  CHECK(it != frozen.landmarks.end()) << "an observation taken out of a summary it is not in";
+  LandmarkSummary& summary = it->second;
+  const Eigen::Vector3d d = o.p - summary.reference;
+  summary.information -= o.h;
+  summary.linear -= o.g - o.h * d;
+  summary.constant -= o.f - o.g.dot(d) + 0.5 * d.dot(o.h * d);
+  if (--summary.observations == 0) frozen.landmarks.erase(it);
+}
+
 std::unique_ptr<ceres::CostFunction> QuadraticLandmarkFactor(const LandmarkSummary& summary) {
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(summary.information);
   const Eigen::Vector3d lambda = eigen.eigenvalues();
@@ -73,7 +84,8 @@ std::unique_ptr<ceres::CostFunction> QuadraticLandmarkFactor(const LandmarkSumma
 // Ceres' own evaluation of each residual with its loss (EvaluateResidualBlock): the
 // corrected residual r and Jacobian J give the gradient J^T r and the Hessian J^T J
 // that Levenberg-Marquardt would take of it, and the cost.
-void Window::SummarizeObservationsOf(StateId state, FrozenObservations& frozen) const {
+void Window::SummarizeObservationsOf(StateId state, FrozenObservations& frozen,
+                                     std::vector<SummarizedObservation>* taken) const {
   for (auto it = observations_.lower_bound({state, LandmarkId(std::numeric_limits<std::int64_t>::min())});
        it != observations_.end() && it->first.first == state; ++it) {
     const Landmark& landmark = landmarks_.at(it->first.second);
@@ -94,9 +106,58 @@ void Window::SummarizeObservationsOf(StateId state, FrozenObservations& frozen) 
       ++frozen.skipped;
       continue;
     }
-    AddToSummary(landmark.position(), cost, jacobian.transpose() * r, jacobian.transpose() * jacobian,
-                 frozen.landmarks[landmark.id]);
+    const SummarizedObservation part{landmark.id, landmark.position(), cost, jacobian.transpose() * r,
+                                     jacobian.transpose() * jacobian};
+    AddToSummary(part.p, part.f, part.g, part.h, frozen.landmarks[landmark.id]);
+    if (taken != nullptr) taken->push_back(part);
   }
+}
+
+// The residuals on the state in id order (priors, the IMU factors into and out of it, its
+// observations), each evaluated with its loss as Ceres' Levenberg-Marquardt takes it.
+Eigen::Matrix<double, 15, 1> Window::StateStep(StateId id) {
+  State& s = state(id);
+  std::vector<ceres::ResidualBlockId> residuals;
+  for (const Prior& prior : priors_) {
+    const bool on_state = std::find(prior.blocks.begin(), prior.blocks.end(), s.pose) != prior.blocks.end() ||
+                          std::find(prior.blocks.begin(), prior.blocks.end(), s.speed_bias) != prior.blocks.end();
+    if (on_state) residuals.push_back(prior.residual);
+  }
+  if (const auto into = imu_edges_.find(id); into != imu_edges_.end()) residuals.push_back(into->second.residual);
+  if (const auto out = imu_edges_.upper_bound(id); out != imu_edges_.end() && out->second.from == id) {
+    residuals.push_back(out->second.residual);
+  }
+  for (auto it = observations_.lower_bound({id, LandmarkId(std::numeric_limits<std::int64_t>::min())});
+       it != observations_.end() && it->first.first == id; ++it) {
+    residuals.push_back(it->second.residual);
+  }
+  const bool was_constant = IsStateConstant(id);
+  SetStateConstant(id, false);  // Ceres evaluates no Jacobian of a constant block
+  Eigen::Matrix<double, 15, 15> h = Eigen::Matrix<double, 15, 15>::Zero();
+  Eigen::Matrix<double, 15, 1> g = Eigen::Matrix<double, 15, 1>::Zero();
+  for (const ceres::ResidualBlockId residual : residuals) {
+    std::vector<double*> blocks;
+    problem_->GetParameterBlocksForResidualBlock(residual, &blocks);
+    const int rows = problem_->GetCostFunctionForResidualBlock(residual)->num_residuals();
+    Eigen::VectorXd r(rows);
+    Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> j_pose = Eigen::MatrixXd::Zero(rows, 6);
+    Eigen::Matrix<double, Eigen::Dynamic, 9, Eigen::RowMajor> j_speed_bias = Eigen::MatrixXd::Zero(rows, 9);
+    std::vector<double*> jacobians(blocks.size(), nullptr);
+    for (size_t k = 0; k < blocks.size(); ++k) {
+      if (blocks[k] == s.pose) jacobians[k] = j_pose.data();
+      if (blocks[k] == s.speed_bias) jacobians[k] = j_speed_bias.data();
+    }
+    double cost = 0;
+    if (!problem_->EvaluateResidualBlock(residual, true, &cost, r.data(), jacobians.data()) || !r.allFinite()) continue;
+    Eigen::Matrix<double, Eigen::Dynamic, 15> j(rows, 15);
+    j << j_pose, j_speed_bias;
+    if (!j.allFinite()) continue;
+    h.noalias() += j.transpose() * j;
+    g.noalias() += j.transpose() * r;
+  }
+  SetStateConstant(id, was_constant);
+  const Eigen::Matrix<double, 15, 1> step = h.ldlt().solve(-g);
+  return step.allFinite() ? step : Eigen::Matrix<double, 15, 1>::Zero();
 }
 
 }  // namespace vio

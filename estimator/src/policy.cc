@@ -8,6 +8,7 @@
 #include "vio/estimator/ekf_policy.h"
 #include "vio/estimator/keyframe_policy.h"
 #include "vio/estimator/msckf_policy.h"
+#include "vio/estimator/smoother_policy.h"
 #include "vio/estimator/swf_policy.h"
 
 namespace vio {
@@ -17,6 +18,7 @@ std::unique_ptr<Policy> MakePolicy(const EstimatorOptions& options) {
   if (name == "swf") return std::make_unique<SwfPolicy>(options);
   if (name == "keyframe") return std::make_unique<KeyframePolicy>(options);
   if (name == "batch") return std::make_unique<BatchPolicy>(options);
+  if (name == "smoother") return std::make_unique<SmootherPolicy>(options);
   if (name == "msckf") return std::make_unique<MsckfPolicy>(options, options.msckf.msckf_gn_steps);
   if (name == "fixed_lag") return std::make_unique<MsckfPolicy>(options, std::nullopt);
   if (name == "ekf" || name == "iekf") return std::make_unique<EkfPolicy>(options, name == "iekf");

@@ -1,5 +1,6 @@
 #include "vio/estimator/refinement.h"
 
+#include <algorithm>
 #include <chrono>
 #include <optional>
 #include <utility>
@@ -108,7 +109,7 @@ SolveReport SolveWhole(Window& window, const EstimatorOptions& options) {
   solver.max_iterations = options.batch.batch_final_iterations;
   // Ceres' own tolerance: the default function_tolerance (1e-3) is set for
   // the Gauss-Newton steps of a window, not for the final solve of everything.
-  solver.function_tolerance = 1e-6;
+  solver.function_tolerance = std::min(1e-6, options.solver.function_tolerance);
   // Bounded by iterations only (a configured wall-time bound is for a window's
   // solves): the final estimate does not depend on machine load.
   solver.max_solver_time_s = 0;

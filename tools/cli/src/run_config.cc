@@ -11,6 +11,7 @@ void BindRunConfig(RunConfig* config, OptionRegistry* registry) {
   registry->Add("persistent", &config->estimator.persistent);
   registry->Add("local_map", &config->estimator.local_map);
   registry->Add("batch", &config->estimator.batch);
+  registry->Add("smoother", &config->estimator.smoother);
   registry->Add("solver", &config->estimator.solver);
   registry->Add("model", &config->estimator.model);
   registry->Add("init", &config->estimator.init);

@@ -34,8 +34,9 @@ struct PolicyOptions {
     v("policy", policy,
       "estimator policy: swf (sliding window), msckf (MSCKF as optimization), ekf (EKF-SLAM: previous state "
       "marginalized before one GN step), iekf (iterated EKF: GN to convergence), fixed_lag (MSCKF "
-      "marginalization, GN to convergence), keyframe (OKVIS-like), batch (no marginalization)",
-      {"swf", "msckf", "ekf", "iekf", "fixed_lag", "keyframe", "batch"});
+      "marginalization, GN to convergence), keyframe (OKVIS-like), batch (no marginalization), smoother "
+      "(incremental: every state kept, each frame the recent states and the older ones that moved solved)",
+      {"swf", "msckf", "ekf", "iekf", "fixed_lag", "keyframe", "batch", "smoother"});
     v("window_size", window_size, "states kept in the sliding window [frames]", AtLeast(1));
     v("swf_landmarks", swf_landmarks,
       "SWF: landmarks seen by the leaving state are kept (paper-exact, prior over them) "
@@ -161,6 +162,34 @@ struct BatchOptions {
       "batch: Gauss-Newton iterations of the final solve over every state and landmark [count]", AtLeast(1));
     v("batch_solve_every", batch_solve_every,
       "batch: while running, solve the recent states every this many frames (IMU prediction between) [frames]", AtLeast(1));
+  }
+};
+
+/// The incremental smoother (smoother_policy.h): every state and landmark kept; each frame
+/// the newest states and the older ones whose pending step is large are solved, the rest
+/// held with their observations summarized per landmark.
+struct SmootherOptions {
+  int smoother_active_states = 10;             ///< newest states solved every frame [frames]
+  double smoother_relinearize_threshold = 1e-3;  ///< an older state's pending step that frees it [m or rad]
+  int smoother_checks_per_frame = 4;           ///< older states whose pending step is checked per frame [count]
+  int smoother_full_every = 0;                 ///< every this many frames every state is solved; 0 = never [frames]
+
+  template <class V>
+  void Visit(V& v) {
+    v("smoother_active_states", smoother_active_states,
+      "smoother: the newest states, solved every frame (the older ones are held unless freed) [frames]", AtLeast(1));
+    v("smoother_relinearize_threshold", smoother_relinearize_threshold,
+      "smoother: an older state joins the frame's solve when its Gauss-Newton step alone (position [m] or "
+      "rotation [rad]) exceeds this [m or rad]",
+      AtLeast(0));
+    v("smoother_checks_per_frame", smoother_checks_per_frame,
+      "smoother: older states whose pending step is checked each frame, the newest held ones and then in turn "
+      "from the oldest; 0 = every one [count]",
+      AtLeast(0));
+    v("smoother_full_every", smoother_full_every,
+      "smoother: every this many frames every state is freed for the frame's solve (the whole problem "
+      "relinearized, by sparse Cholesky); 0 = never [frames]",
+      AtLeast(0));
   }
 };
 
@@ -324,6 +353,7 @@ struct EstimatorOptions {
   PersistentOptions persistent;
   LocalMapOptions local_map;
   BatchOptions batch;
+  SmootherOptions smoother;
   SolverOptions solver;
   ModelOptions model;
   InitOptions init;

@@ -25,6 +25,16 @@ struct LandmarkSummary {
   int observations = 0;
 };
 
+/// One observation's part of a summary (what AddToSummary added), kept to take it out again
+/// (the smoother frees a held state).
+struct SummarizedObservation {
+  LandmarkId landmark;
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();  ///< [m], the landmark where it was taken
+  double f = 0;
+  Eigen::Vector3d g = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+};
+
 struct FrozenObservations {
   std::map<LandmarkId, LandmarkSummary> landmarks;
   int skipped = 0;  ///< observations that did not evaluate when their state froze (left out)
@@ -34,5 +44,9 @@ struct FrozenObservations {
 /// position) taken at `p` to `summary`.
 void AddToSummary(const Eigen::Vector3d& p, double f, const Eigen::Vector3d& g, const Eigen::Matrix3d& h,
                   LandmarkSummary& summary);
+
+/// Takes `observation` out of its landmark's summary in `frozen` (the exact inverse of
+/// AddToSummary with the same arguments); a summary left with no observation is erased.
+void RemoveFromSummary(const SummarizedObservation& observation, FrozenObservations& frozen);
 
 }  // namespace vio

@@ -204,8 +204,14 @@ class Window {
   /// observations must be in `frozen`.
   SolveReport SolveSparse(const SolverOptions& options, const FrozenObservations& frozen);
   /// Adds the observations of `state` at the current values to `frozen`, before the state is
-  /// held constant for good; the landmarks they see must be variable.
-  void SummarizeObservationsOf(StateId state, FrozenObservations& frozen) const;
+  /// held constant; the landmarks they see must be variable. `taken`: each part added, appended.
+  void SummarizeObservationsOf(StateId state, FrozenObservations& frozen,
+                               std::vector<SummarizedObservation>* taken = nullptr) const;
+  /// The Gauss-Newton step of one state's [pose, speed_bias] alone, every other block held, over
+  /// the residuals on it (priors, IMU factors, observations) at the current values, on its
+  /// tangent [dp (m), dtheta (rad), dv, dbg, dba]; zero when they do not evaluate (the smoother's
+  /// relinearization test of a held state).
+  Eigen::Matrix<double, 15, 1> StateStep(StateId state);
   /// Re-preintegrates IMU factors whose gyro-bias linearization moved too far; only those into
   /// `first_to` and later states (batch: the others start at states frozen since they were checked).
   int RefreshImuFactors(double gyro_bias_threshold,
