@@ -27,6 +27,7 @@ Estimator::Estimator(const EstimatorOptions& options, const ImuCalibration& imu,
   imu_calibration_.gyro_random_walk *= options.model.imu_noise_scale;
   imu_calibration_.accel_random_walk *= options.model.imu_noise_scale;
   EstimateCalibration();
+  if (options_.model.extrinsics_rotation_search) rig_search_.emplace();
 }
 
 void Estimator::EstimateCalibration() {

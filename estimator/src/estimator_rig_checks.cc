@@ -1,6 +1,7 @@
-// Estimator's checks of the rig against physics (rig_checks.h, docs/bad-input.md) and the coarse
-// camera-IMU time offset search at initialization (time_offset_search.h, docs/calibration.md):
-// both compare the gyro's rotation with the stereo camera's over frame pairs.
+// Estimator's checks of the rig against physics (rig_checks.h, docs/bad-input.md), the coarse
+// camera-IMU time offset search and the rig rotation search at initialization (time_offset_search.h,
+// rig_rotation_search.h, docs/calibration.md): each compares the gyro's rotation with the stereo
+// camera's over frame pairs.
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -26,6 +27,12 @@ constexpr double kBeyondRangeImprovement = 25.0;
 // A search result lies beyond the prior when this many of the prior's sigmas and of its own away.
 constexpr double kFarPriorSigmas = 2.0;
 constexpr double kFarSearchSigmas = 3.0;
+// The rig rotation search tells the rotation only when its largest sigma is below this (a motion
+// that turns about one axis leaves the rotation about it unknown) [rad] (0.5 deg).
+constexpr double kMaxRigSearchSigmaRad = 0.5 * M_PI / 180.0;
+// The rig rotation search's frame pairs: each frame with the oldest of the last this many seconds
+// (at least half of it back) [s].
+constexpr double kRigPairSpanS = 1.0;
 
 std::string Milliseconds(double s) {
   std::ostringstream os;
@@ -57,6 +64,7 @@ void Estimator::StartTimeOffsetSearch() {
 // The search takes the pairs at their camera stamps less the prior's mean: one base for every pair
 // while the estimate moves.
 void Estimator::CheckRotation(const StereoFrame& frame, Timestamp search_t_ns) {
+  if (rig_search_) AddRigSearchFrame(frame);
   const bool checking = !rotation_check_.decided();
   if (!checking && !offset_search_) return;
   if (offset_search_ && offset_search_start_ns_ < 0) offset_search_start_ns_ = frame.t_ns;
@@ -94,6 +102,71 @@ void Estimator::CheckRotation(const StereoFrame& frame, Timestamp search_t_ns) {
     }
   }
   if (rotation_check_.decided() && !offset_search_) rotation_frames_.clear();
+}
+
+// Pairs kRigPairSpanS apart (a 3D-3D fit's rotation error is about the same at any span, the
+// rotation grows with it), the gyro's rotation composed over each.
+void Estimator::AddRigSearchFrame(const StereoFrame& frame) {
+  if (rig_search_start_ns_ < 0) rig_search_start_ns_ = frame.t_ns;
+  Eigen::Quaterniond q_gyro = Eigen::Quaterniond::Identity();
+  if (!rig_frames_.empty()) {
+    const RigSearchFrame& last = rig_frames_.back();
+    const bool covered = !imu_.empty() && imu_.front().t_ns <= last.frame.t_ns && imu_.back().t_ns >= frame.t_ns;
+    if (covered && last.frame.t_ns < frame.t_ns) {
+      q_gyro = last.q_gyro * IntegratedRotation(imu_, last.frame.t_ns, frame.t_ns);
+    } else {
+      rig_frames_.clear();
+    }
+  }
+  rig_frames_.push_back({frame, q_gyro});
+  const Timestamp span_ns = SecondsToNanos(kRigPairSpanS);
+  while (rig_frames_.front().frame.t_ns < frame.t_ns - span_ns) rig_frames_.pop_front();
+  const RigSearchFrame& first = rig_frames_.front();
+  if (2 * (frame.t_ns - first.frame.t_ns) >= span_ns) {
+    const std::optional<StereoRelativePose> camera =
+        WeightedRelativeStereoPose(first.frame, frame, window_.stereo(), options_.model, options_.init.dynamic_min_landmarks);
+    if (camera) {
+      rig_search_->AddPair(so3::Log(first.q_gyro.conjugate() * q_gyro), so3::Log(Eigen::Matrix3d(camera->T_a_b.linear())),
+                           NanosToSeconds(frame.t_ns - first.frame.t_ns));
+    }
+  }
+  if (!rig_search_->result() && frame.t_ns - rig_search_start_ns_ > SecondsToNanos(kMaxSearchS)) rig_search_->Decide();
+  if (rig_search_->result()) {
+    ApplyRigRotationSearch(*rig_search_->result());
+  } else if (frame.t_ns - rig_search_start_ns_ > SecondsToNanos(kMaxSearchS)) {
+    LOG(INFO) << "rig rotation search: too little rotation in the first " << kMaxSearchS
+              << " s; sensor.yaml's camera rotation is kept";
+    rig_search_.reset();
+  }
+  if (!rig_search_) rig_frames_.clear();
+}
+
+void Estimator::ApplyRigRotationSearch(const RigRotationSearch::Result& result) {
+  rig_search_.reset();
+  RigRotationSearchReport report;
+  report.rotation_vector = result.rotation_vector;
+  report.sigma_rad = result.sigma_rad;
+  report.pairs = result.pairs;
+  report.excited = result.sigma_rad < kMaxRigSearchSigmaRad;
+  const double angle = result.rotation_vector.norm();
+  const double prior_rad = options_.model.extrinsics_prior_sigma_deg * M_PI / 180.0;
+  const Eigen::Vector3d axis = angle > 0 ? Eigen::Vector3d(result.rotation_vector / angle) : Eigen::Vector3d::UnitZ();
+  std::ostringstream what;
+  what << std::fixed << std::setprecision(2) << "rig rotation search: the gyro follows the camera best with the rig turned by "
+       << angle * 180.0 / M_PI << " deg about (" << axis.x() << ", " << axis.y() << ", " << axis.z()
+       << ") in the body, +- " << result.sigma_rad * 180.0 / M_PI << " deg (" << result.pairs << " frame pairs, "
+       << result.rotation_rad << " rad of camera rotation)";
+  if (!report.excited) {
+    LOG(INFO) << what.str() << ": the motion did not turn about every axis enough to tell; sensor.yaml's camera "
+                               "rotation is kept";
+  } else if (angle > std::max(kFarPriorSigmas * prior_rad, kFarSearchSigmas * result.sigma_rad)) {
+    report.restart = true;
+    LOG(INFO) << what.str() << ": beyond the extrinsics' prior (extrinsics_prior_sigma_deg "
+              << options_.model.extrinsics_prior_sigma_deg << ")";
+  } else {
+    LOG(INFO) << what.str() << ": consistent with sensor.yaml";
+  }
+  rig_rotation_search_ = report;
 }
 
 void Estimator::ApplyTimeOffsetSearch(const TimeOffsetSearch::Result& result) {

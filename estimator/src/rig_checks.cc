@@ -7,6 +7,8 @@
 
 #include <glog/logging.h>
 
+#include "vio/estimator/so3.h"
+
 namespace vio {
 namespace {
 
@@ -84,6 +86,19 @@ Eigen::Vector3d IntegratedGyro(const std::vector<ImuSample>& imu, Timestamp t0_n
     sum += 0.5 * (imu[i - 1].gyro_rad_s + imu[i].gyro_rad_s) * NanosToSeconds(to - from);
   }
   return sum;
+}
+
+Eigen::Quaterniond IntegratedRotation(const std::vector<ImuSample>& imu, Timestamp t0_ns, Timestamp t1_ns) {
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  const auto first = std::lower_bound(imu.begin(), imu.end(), t0_ns,
+                                      [](const ImuSample& m, Timestamp t) { return m.t_ns < t; });
+  for (auto i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(1, first - imu.begin()));
+       i < imu.size() && imu[i - 1].t_ns < t1_ns; ++i) {
+    const Timestamp from = std::max(imu[i - 1].t_ns, t0_ns), to = std::min(imu[i].t_ns, t1_ns);
+    if (to <= from) continue;
+    q = q * so3::ExpQuaternion(0.5 * (imu[i - 1].gyro_rad_s + imu[i].gyro_rad_s) * NanosToSeconds(to - from));
+  }
+  return q.normalized();
 }
 
 std::string CheckFreeGravity(double free_gravity_norm, const RigLimits& limits) {

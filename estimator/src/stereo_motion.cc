@@ -4,8 +4,11 @@
 #include <map>
 #include <sstream>
 
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <Eigen/SVD>
 
+#include "vio/estimator/so3.h"
 #include "vio/estimator/stereo_geometry.h"
 
 namespace vio {
@@ -17,7 +20,20 @@ namespace {
 struct PointPair {
   Eigen::Vector3d p_a, p_b;
   double sigma = 1.0;
+  Eigen::Vector3d z_a, z_b;  ///< the observations (u_L, u_R, v) [px]
 };
+
+// The covariance of the stereo point of z_px in the body: J J^T sigma^2, J the triangulation's
+// Jacobian on (u_L, u_R, v) (its depth error along the ray).
+Eigen::Matrix3d StereoPointCovariance(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo, double pixel_sigma) {
+  const double d = z_px.x() - z_px.y();
+  const double z = stereo.f * stereo.baseline / d;
+  const double xf = (z_px.x() - stereo.cx) / stereo.f, yf = (z_px.z() - stereo.cy) / stereo.f;
+  Eigen::Matrix3d J;  // rows x, y, z; columns u_L, u_R, v
+  J << z / stereo.f - xf * z / d, xf * z / d, 0, -yf * z / d, yf * z / d, z / stereo.f, -z / d, z / d, 0;
+  const Eigen::Matrix3d R_b_c = stereo.T_b_cl.linear();
+  return pixel_sigma * pixel_sigma * R_b_c * J * J.transpose() * R_b_c.transpose();
+}
 
 double StereoPointSigma(double depth_m, const RectifiedStereo& stereo, double pixel_sigma) {
   const double lateral = depth_m * pixel_sigma / stereo.f;
@@ -35,6 +51,13 @@ std::map<LandmarkId, Eigen::Vector3d> StereoPointsInCamera(const StereoFrame& fr
   return points;
 }
 
+Eigen::Vector3d ObservationOf(const StereoFrame& frame, LandmarkId id) {
+  for (const StereoObservation& obs : frame.observations) {
+    if (obs.landmark == id) return obs.z_px;
+  }
+  return Eigen::Vector3d::Zero();
+}
+
 std::vector<PointPair> SharedPoints(const StereoFrame& a, const StereoFrame& b, const RectifiedStereo& stereo,
                                     const ModelOptions& model) {
   const std::map<LandmarkId, Eigen::Vector3d> in_a = StereoPointsInCamera(a, stereo, model);
@@ -45,7 +68,8 @@ std::vector<PointPair> SharedPoints(const StereoFrame& a, const StereoFrame& b, 
     if (it == in_b.end()) continue;
     const double sa = StereoPointSigma(p_cl_a.z(), stereo, model.pixel_sigma);
     const double sb = StereoPointSigma(it->second.z(), stereo, model.pixel_sigma);
-    pairs.push_back({stereo.T_b_cl * p_cl_a, stereo.T_b_cl * it->second, std::sqrt(sa * sa + sb * sb)});
+    pairs.push_back({stereo.T_b_cl * p_cl_a, stereo.T_b_cl * it->second, std::sqrt(sa * sa + sb * sb),
+                     ObservationOf(a, id), ObservationOf(b, id)});
   }
   return pairs;
 }
@@ -91,6 +115,54 @@ int RejectOutliers(const std::vector<PointPair>& pairs, const Eigen::Isometry3d&
   return kept;
 }
 
+// The rigid fit with outlier rejection; nothing when fewer than min_landmarks are kept.
+std::optional<StereoRelativePose> FitPairs(const std::vector<PointPair>& pairs, int min_landmarks,
+                                           std::vector<bool>* keep) {
+  if (static_cast<int>(pairs.size()) < std::max(3, min_landmarks)) return std::nullopt;
+  keep->assign(pairs.size(), true);
+  StereoRelativePose out;
+  out.shared = static_cast<int>(pairs.size());
+  out.T_a_b = FitRigid(pairs, *keep);
+  for (int round = 0; round < 2; ++round) {
+    out.inliers = RejectOutliers(pairs, out.T_a_b, keep);
+    if (out.inliers < std::max(3, min_landmarks)) return std::nullopt;
+    out.T_a_b = FitRigid(pairs, *keep);
+  }
+  return out;
+}
+
+// Gauss-Newton on r_i = p_a - (R p_b + t), weighted by (C_a + R C_b R^T)^-1; the perturbation
+// R <- R Exp(dtheta), t <- t + dt.
+Eigen::Isometry3d RefineWeighted(const std::vector<PointPair>& pairs, const std::vector<bool>& keep,
+                                 const RectifiedStereo& stereo, double pixel_sigma, Eigen::Isometry3d T) {
+  constexpr int kIterations = 5;
+  std::vector<Eigen::Matrix3d> cov_a(pairs.size()), cov_b(pairs.size());
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    if (!keep[i]) continue;
+    cov_a[i] = StereoPointCovariance(pairs[i].z_a, stereo, pixel_sigma);
+    cov_b[i] = StereoPointCovariance(pairs[i].z_b, stereo, pixel_sigma);
+  }
+  for (int iteration = 0; iteration < kIterations; ++iteration) {
+    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    const Eigen::Matrix3d R = T.linear();
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      if (!keep[i]) continue;
+      const Eigen::Vector3d r = pairs[i].p_a - T * pairs[i].p_b;
+      Eigen::Matrix<double, 3, 6> J;
+      J << -Eigen::Matrix3d::Identity(), R * so3::Hat(pairs[i].p_b);
+      const Eigen::Matrix3d W = (cov_a[i] + R * cov_b[i] * R.transpose()).inverse();
+      H += J.transpose() * W * J;
+      g += J.transpose() * W * r;
+    }
+    const Eigen::Matrix<double, 6, 1> step = -H.ldlt().solve(g);
+    if (!step.allFinite()) break;
+    T.translation() += step.head<3>();
+    T.linear() = R * so3::Exp(step.tail<3>());
+  }
+  return T;
+}
+
 }  // namespace
 
 std::optional<StereoRelativePose> RelativeStereoPose(const StereoFrame& a, const StereoFrame& b,
@@ -98,16 +170,17 @@ std::optional<StereoRelativePose> RelativeStereoPose(const StereoFrame& a, const
                                                      int min_landmarks, int* shared) {
   const std::vector<PointPair> pairs = SharedPoints(a, b, stereo, model);
   if (shared != nullptr) *shared = static_cast<int>(pairs.size());
-  if (static_cast<int>(pairs.size()) < std::max(3, min_landmarks)) return std::nullopt;
-  std::vector<bool> keep(pairs.size(), true);
-  StereoRelativePose out;
-  out.shared = static_cast<int>(pairs.size());
-  out.T_a_b = FitRigid(pairs, keep);
-  for (int round = 0; round < 2; ++round) {
-    out.inliers = RejectOutliers(pairs, out.T_a_b, &keep);
-    if (out.inliers < std::max(3, min_landmarks)) return std::nullopt;
-    out.T_a_b = FitRigid(pairs, keep);
-  }
+  std::vector<bool> keep;
+  return FitPairs(pairs, min_landmarks, &keep);
+}
+
+std::optional<StereoRelativePose> WeightedRelativeStereoPose(const StereoFrame& a, const StereoFrame& b,
+                                                             const RectifiedStereo& stereo, const ModelOptions& model,
+                                                             int min_landmarks) {
+  const std::vector<PointPair> pairs = SharedPoints(a, b, stereo, model);
+  std::vector<bool> keep;
+  std::optional<StereoRelativePose> out = FitPairs(pairs, min_landmarks, &keep);
+  if (out) out->T_a_b = RefineWeighted(pairs, keep, stereo, model.pixel_sigma, out->T_a_b);
   return out;
 }
 

@@ -1,6 +1,7 @@
 // The rig checks (rig_checks.h): each rule on values that pass and values that must not, with the
 // cause it names.
 #include "vio/estimator/rig_checks.h"
+#include "vio/estimator/so3.h"
 
 #include <cmath>
 #include <random>
@@ -59,6 +60,20 @@ TEST(RigChecks, IntegratedGyroIsTheTrapezoidalSumOverTheInterval) {
   EXPECT_NEAR(sum.x(), 0.04, 1e-12);
   EXPECT_NEAR(sum.y(), -0.08, 1e-12);
   EXPECT_NEAR(sum.z(), 0.13, 1e-12);  // 0.04 s at the mean rate 3.25
+}
+
+TEST(RigChecks, IntegratedRotationComposesTheRatesOverTheInterval) {
+  std::vector<ImuSample> imu;
+  const Eigen::Vector3d rate(1.0, -2.0, 0.5);
+  for (int i = 0; i <= 200; ++i) imu.push_back({i * 5'000'000LL, rate, {}});
+  // A constant rate: the rotation about it by rate * 0.9 s, to rounding.
+  const Eigen::Quaterniond q = IntegratedRotation(imu, 12'500'000, 912'500'000);
+  EXPECT_LT(so3::Log(Eigen::Quaterniond(q * so3::ExpQuaternion(-0.9 * rate))).norm(), 1e-12);
+  // A rate turning about another axis: the composition is not the summed vector's rotation.
+  for (int i = 0; i <= 200; ++i) imu[i].gyro_rad_s = Eigen::Vector3d(1.0, 0.0, 0.01 * i);
+  const Eigen::Quaterniond turning = IntegratedRotation(imu, 0, 1'000'000'000);
+  const Eigen::Vector3d summed = IntegratedGyro(imu, 0, 1'000'000'000);
+  EXPECT_GT(so3::Log(Eigen::Quaterniond(turning * so3::ExpQuaternion(-summed))).norm(), 1e-3);
 }
 
 // Rotation vectors of frame pairs, 0.1-0.3 rad each: `gyro` maps the camera's to the gyro's.

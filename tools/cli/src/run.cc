@@ -215,7 +215,8 @@ void AddEarlierEstimates(Estimator& estimator, Timestamp first_covered_ns, Times
 // Bad data mid-run ends the loop with a status; what was estimated is kept.
 // `observations` (null: none written) receives every frame the estimator is given.
 // A stop request ends it before the next frame, or (a solve cut short) drops the frame in hand.
-// Returns true when the time offset search found the offset beyond its prior (the pass ends there).
+// Returns true when a search at initialization (time offset, rig rotation) found the rig beyond its
+// prior (the pass ends there).
 bool EstimateFrames(const RunRequest& request, const EurocDataset& dataset, FrameSource& source,
                     Estimator& estimator, RunOutput& output, ObservationsCsvWriter* observations,
                     ProgressBar& progress, RunResult* result) {
@@ -258,7 +259,7 @@ bool EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
         StopAt(k, source.size(), "bad_input", problem, result);
         break;
       }
-      if (estimator.time_offset_search() && estimator.time_offset_search()->restart) return true;
+      if (estimator.restart_requested()) return true;
       if (!estimate.initialized) {
         ++result->health.frames_waiting_init;
         result->init.last_reason = estimator.waiting_reason();
@@ -444,11 +445,11 @@ void ValidateRequest(const RunRequest& request) {
   }
 }
 
-// One pass over the dataset. `search`: the time offset search's result of an earlier pass that ended
-// at it (this one runs with the prior there; `earlier_pass_s` its processing time, counted in this
-// one's), else empty and filled when this pass's search asks to start again (nothing is written then).
-RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset,
-                  std::optional<Estimator::TimeOffsetSearchReport>* search, double earlier_pass_s) {
+// One pass over the dataset. `searches`: the searches' results of an earlier pass that ended at them
+// (this one runs with the rig they found; `earlier_pass_s` its processing time, counted in this
+// one's), else empty and filled when this pass's searches ask to start again (nothing is written then).
+RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset, InitSearches* searches,
+                  double earlier_pass_s) {
   RunRequest request = requested;
   request.config.frontend.frontend = ResolveFrontend(requested.config.frontend.frontend, dataset);
   const frontend::StereoRectifier rectifier(dataset.cameras[0], dataset.cameras[1]);
@@ -458,7 +459,7 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset,
   if (request.config.estimator.init.init == "groundtruth" && dataset.groundtruth.empty()) {
     throw std::runtime_error(request.dataset_dir + ": --init=groundtruth but the dataset has no ground truth");
   }
-  Estimator estimator(request.config.estimator, dataset.imu_calibration, rectifier.rectified());
+  Estimator estimator(request.config.estimator, dataset.imu_calibration, TurnedRig(rectifier.rectified(), *searches));
   const bool refine = request.trajectory == "smoothed" && request.config.estimator.policy.policy != "batch";
   if (refine) estimator.KeepMeasurements();
   RunOutput output(request.output_dir);
@@ -480,7 +481,7 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset,
   if (EstimateFrames(request, dataset, *source, estimator, output, observations ? &*observations : nullptr, progress,
                      &result)) {
     progress.Stop();
-    *search = estimator.time_offset_search();
+    *searches = InitSearches{estimator.time_offset_search(), estimator.rig_rotation_search()};
     result.processing_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
   }
@@ -493,8 +494,13 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset,
     FinishEstimates(request, estimator, output, solve_log, &result);
   }
   // After the final solve: batch's offset is the whole sequence's, not its online estimate's.
-  RecordCalibration(dataset, estimator, *search ? *search : estimator.time_offset_search(), &result.calibration);
-  if (estimator.window().estimates_extrinsics()) WriteCalibration(dataset, estimator.window(), request.output_dir + "/calibration");
+  const InitSearches found = searches->restart()
+                                 ? *searches
+                                 : InitSearches{estimator.time_offset_search(), estimator.rig_rotation_search()};
+  RecordCalibration(dataset, estimator, found, &result.calibration);
+  if (estimator.window().estimates_extrinsics() || searches->restart()) {
+    WriteCalibration(dataset, estimator.window(), rectifier.rectified().T_b_cl, request.output_dir + "/calibration");
+  }
   if (refine && result.status == "ok") {
     solve_log.SetPhase("refinement");
     RefineEstimates(request, estimator, output, &result);
@@ -523,24 +529,39 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset,
 
 }  // namespace
 
-// The time offset search at initialization found the camera-IMU offset beyond its prior: the run
-// starts again from the first frame with the prior there (docs/calibration.md).
+// A search at initialization found the camera-IMU time offset or the rig's rotation beyond its prior:
+// the run starts again from the first frame with the rig found (docs/calibration.md).
 RunResult RunDataset(const RunRequest& requested) {
   ValidateRunConfig(requested.config);
   ValidateRequest(requested);
   WarnAboutQuestionableSettings(requested.config);
   const EurocDataset dataset = ReadRunDataset(requested);
-  std::optional<Estimator::TimeOffsetSearchReport> search;
-  const RunResult first = RunPass(requested, dataset, &search, 0.0);
-  if (!search) return first;
+  InitSearches searches;
+  const RunResult first = RunPass(requested, dataset, &searches, 0.0);
+  if (!searches.restart()) return first;
   RunRequest again = requested;
-  again.config.estimator.model.time_offset_prior_mean_ms = 1e3 * search->offset_s;
-  again.config.estimator.model.time_offset_search_ms = 0;
-  LOG(WARNING) << "the camera-IMU time offset is " << 1e3 * search->offset_s << " +- " << 1e3 * search->sigma_s
-               << " ms, beyond its prior (time_offset_prior_mean_ms " << requested.config.estimator.model.time_offset_prior_mean_ms
-               << " +- " << requested.config.estimator.model.time_offset_prior_sigma_ms
-               << " ms): starting again from the first frame with the prior's mean there";
-  return RunPass(again, dataset, &search, first.processing_s);
+  ModelOptions& model = again.config.estimator.model;
+  model.time_offset_search_ms = 0;
+  model.extrinsics_rotation_search = false;
+  if (searches.time_offset && searches.time_offset->restart) {
+    const Estimator::TimeOffsetSearchReport& search = *searches.time_offset;
+    model.time_offset_prior_mean_ms = 1e3 * search.offset_s;
+    LOG(WARNING) << "the camera-IMU time offset is " << 1e3 * search.offset_s << " +- " << 1e3 * search.sigma_s
+                 << " ms, beyond its prior (time_offset_prior_mean_ms " << requested.config.estimator.model.time_offset_prior_mean_ms
+                 << " +- " << requested.config.estimator.model.time_offset_prior_sigma_ms
+                 << " ms): starting again from the first frame with the prior's mean there";
+  }
+  if (searches.rig_rotation && searches.rig_rotation->restart) {
+    const Estimator::RigRotationSearchReport& search = *searches.rig_rotation;
+    // The search is within about a degree (the gyro's own axes against the accelerometer's): the
+    // online correction takes it from there.
+    model.estimate_extrinsics = true;
+    LOG(WARNING) << "the cameras' rotation in the body is off by " << search.rotation_vector.norm() * 180.0 / M_PI
+                 << " +- " << search.sigma_rad * 180.0 / M_PI << " deg from sensor.yaml's (beyond "
+                 << "2 extrinsics_prior_sigma_deg): starting again from the first frame with the cameras turned by it "
+                    "and the extrinsics estimated online";
+  }
+  return RunPass(again, dataset, &searches, first.processing_s);
 }
 
 }  // namespace vio::tools

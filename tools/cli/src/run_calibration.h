@@ -10,14 +10,32 @@
 
 namespace vio::tools {
 
+/// What the searches at initialization found (Estimator::time_offset_search, rig_rotation_search).
+struct InitSearches {
+  std::optional<Estimator::TimeOffsetSearchReport> time_offset;
+  std::optional<Estimator::RigRotationSearchReport> rig_rotation;
+  /// Whether either asked to start the run again.
+  bool restart() const {
+    return (time_offset && time_offset->restart) || (rig_rotation && rig_rotation->restart);
+  }
+  /// The turn of sensor.yaml's cameras in the body the rig rotation search asked for (else identity).
+  Eigen::Matrix3d RigTurn() const;
+};
+
+/// `rig`'s left camera turned in the body by the rig rotation search's result when it asked for it
+/// (the run's second pass), else `rig` unchanged.
+RectifiedStereo TurnedRig(const RectifiedStereo& rig, const InitSearches& searches);
+
 /// The calibration the run ends with: the time offset (the calibration file's plus the estimate)
-/// and the extrinsics' correction, with their sigmas.
-void RecordCalibration(const EurocDataset& dataset, Estimator& estimator,
-                       const std::optional<Estimator::TimeOffsetSearchReport>& search, CalibrationReport* calibration);
+/// and the extrinsics' change from sensor.yaml's (the searches' turn and the window's correction),
+/// with their sigmas.
+void RecordCalibration(const EurocDataset& dataset, Estimator& estimator, const InitSearches& searches,
+                       CalibrationReport* calibration);
 
 /// Writes `dir`/mav0/{cam0,cam1,imu0}/sensor.yaml: the dataset's calibration with both cameras'
-/// T_BS moved rigidly by the window's extrinsics correction (the baseline kept); a folder
-/// --calibration takes.
-void WriteCalibration(const EurocDataset& dataset, const Window& window, const std::string& dir);
+/// T_BS moved rigidly from `given` (sensor.yaml's rectified left camera in the body) to the window's
+/// estimated rig (the baseline kept); a folder --calibration takes.
+void WriteCalibration(const EurocDataset& dataset, const Window& window, const Eigen::Isometry3d& given,
+                      const std::string& dir);
 
 }  // namespace vio::tools

@@ -154,6 +154,13 @@ void WriteExtrinsics(const CalibrationReport& c, std::ostream& out) {
       << ", \"extrinsics_translation_vector_m\": " << vector(c.extrinsics_translation_m);
   if (c.extrinsics_rotation_sigma_deg) out << ", \"extrinsics_rotation_sigma_deg\": " << JsonNumber(*c.extrinsics_rotation_sigma_deg);
   if (c.extrinsics_translation_sigma_m) out << ", \"extrinsics_translation_sigma_m\": " << JsonNumber(*c.extrinsics_translation_sigma_m);
+  if (c.rig_rotation_search_deg) {
+    out << ", \"rig_rotation_search\": {\"rotation_vector_deg\": " << vector(*c.rig_rotation_search_deg)
+        << ", \"rotation_deg\": " << JsonNumber(c.rig_rotation_search_deg->norm())
+        << ", \"sigma_deg\": " << JsonNumber(c.rig_rotation_search_sigma_deg)
+        << ", \"excited\": " << (c.rig_rotation_search_excited ? "true" : "false")
+        << ", \"restarted\": " << (c.rig_rotation_search_restarted ? "true" : "false") << "}";
+  }
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "vio/estimator/policy.h"
 #include "vio/estimator/refinement.h"
 #include "vio/estimator/rig_checks.h"
+#include "vio/estimator/rig_rotation_search.h"
 #include "vio/estimator/time_offset_search.h"
 #include "vio/estimator/tracking_monitor.h"
 #include "vio/estimator/window.h"
@@ -77,6 +78,21 @@ class Estimator {
     bool restart = false;
   };
   const std::optional<TimeOffsetSearchReport>& time_offset_search() const { return time_offset_search_; }
+  /// The rig rotation search at initialization (RigRotationSearch), once it decided.
+  struct RigRotationSearchReport {
+    Eigen::Vector3d rotation_vector = Eigen::Vector3d::Zero();  ///< the rig's turn in the body, Log(Q) [rad]
+    double sigma_rad = 0;  ///< its largest standard deviation over directions (optimistic) [rad]
+    int pairs = 0;         ///< frame pairs compared
+    bool excited = false;  ///< the motion turned about every axis enough to tell (its sigma below 0.5 deg)
+    /// It lies beyond the extrinsics' prior: a run from the start with sensor.yaml's cameras turned
+    /// by it is recommended.
+    bool restart = false;
+  };
+  const std::optional<RigRotationSearchReport>& rig_rotation_search() const { return rig_rotation_search_; }
+  /// Whether a search asks to start the run again (time offset or rig rotation).
+  bool restart_requested() const {
+    return (time_offset_search_ && time_offset_search_->restart) || (rig_rotation_search_ && rig_rotation_search_->restart);
+  }
 
   /// Ends the run. For an offline policy (batch) this is where it solves;
   /// it then returns the final estimate of every state (which replaces the
@@ -152,6 +168,8 @@ class Estimator {
   /// The search's result: an input problem when it lies at its range's end, a recommended restart
   /// when beyond the prior (TimeOffsetSearchReport).
   void ApplyTimeOffsetSearch(const TimeOffsetSearch::Result& result);
+  /// The rig rotation search's result: a recommended restart when beyond the extrinsics' prior.
+  void ApplyRigRotationSearch(const RigRotationSearch::Result& result);
   /// Dynamic initialization from the buffered frames ending at this one.
   bool TryDynamic(std::string* reason);
   /// The buffered frames (time order) from t_ns - span_s on.
@@ -199,6 +217,17 @@ class Estimator {
   std::optional<TimeOffsetSearch> offset_search_;  ///< while the coarse time offset search runs
   Timestamp offset_search_start_ns_ = -1;           ///< the first frame the search saw
   std::optional<TimeOffsetSearchReport> time_offset_search_;  ///< its result, once decided
+  std::optional<RigRotationSearch> rig_search_;     ///< while the rig rotation search runs
+  /// A frame of the rig rotation search's span, with the gyro's rotation composed up to it.
+  struct RigSearchFrame {
+    StereoFrame frame;
+    Eigen::Quaterniond q_gyro;  ///< the gyro's rotation from the first frame kept to this one
+  };
+  std::deque<RigSearchFrame> rig_frames_;  ///< the last kRigPairSpanS of frames, while the search runs
+  Timestamp rig_search_start_ns_ = -1;     ///< the first frame the search saw
+  /// Pairs the frame with the oldest of the span for the rig rotation search; decides at its end.
+  void AddRigSearchFrame(const StereoFrame& frame);
+  std::optional<RigRotationSearchReport> rig_rotation_search_;  ///< its result, once decided
   int implausible_inits_ = 0;                   ///< dynamic initializations in a row that were implausible
   std::string input_problem_;
   std::optional<MeasurementLog> log_;  ///< with KeepMeasurements: every state's measurements

@@ -250,6 +250,7 @@ struct ModelOptions {
   double extrinsics_prior_sigma_deg = 1.0;  ///< prior standard deviation of its rotation, per axis [deg]
   double extrinsics_prior_sigma_m = 0.02;   ///< prior standard deviation of its translation, per axis [m]
   double time_offset_search_ms = 100.0;  ///< range of the coarse search at initialization, either side [ms]; 0: none
+  bool extrinsics_rotation_search = true;  ///< the rig's rotation found from gyro against camera at initialization
 
   template <class V>
   void Visit(V& v) {
@@ -292,6 +293,10 @@ struct ModelOptions {
       "this far either side of time_offset_prior_mean_ms; a match beyond the prior starts the run again with the "
       "prior's mean there, one at the range's end stops it (bad_input); 0: no search [ms]",
       Between(0, 1000));
+    v("extrinsics_rotation_search", extrinsics_rotation_search,
+      "in the first seconds of rotation the rig's rotation is fitted to the gyro's against the camera's (hand-eye); "
+      "a rotation beyond 2 extrinsics_prior_sigma_deg (and 3 of its own sigmas) starts the run again with sensor.yaml's "
+      "cameras turned by it (docs/calibration.md)");
   }
 };
 

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "vio/estimator/types.h"
 
 namespace vio {
@@ -40,6 +42,10 @@ std::string CheckBiases(const Eigen::Vector3d& gyro_bias, const Eigen::Vector3d&
 /// rotation: to first order the rotation vector, and unlike a rotation it does not wrap when the gyro
 /// reads 57 times too much.
 Eigen::Vector3d IntegratedGyro(const std::vector<ImuSample>& imu, Timestamp t0_ns, Timestamp t1_ns);
+
+/// The gyro's readings over [t0_ns, t1_ns] composed as a rotation R_t0_t1 (each sample interval
+/// at its mean rate), for spans whose rotation vectors do not simply add.
+Eigen::Quaterniond IntegratedRotation(const std::vector<ImuSample>& imu, Timestamp t0_ns, Timestamp t1_ns);
 
 /// The dynamic initializer's free gravity (stereo motion aligned to the accelerometer): a norm near
 /// gravity / 9.81 (or 1000 times that), within a factor of 2, is an accelerometer in g (or mg); other misfits are not

@@ -27,6 +27,13 @@ std::optional<StereoRelativePose> RelativeStereoPose(const StereoFrame& a, const
                                                      const RectifiedStereo& stereo, const ModelOptions& model,
                                                      int min_landmarks, int* shared = nullptr);
 
+/// RelativeStereoPose refined by Gauss-Newton on the shared points' differences weighted by their
+/// full stereo covariances (a point's depth error lies along its ray): the isotropic fit's rotation
+/// is biased by that (about 1 deg over EuRoC-like motion), this one is not to first order.
+std::optional<StereoRelativePose> WeightedRelativeStereoPose(const StereoFrame& a, const StereoFrame& b,
+                                                             const RectifiedStereo& stereo, const ModelOptions& model,
+                                                             int min_landmarks);
+
 /// Body poses of every frame in the first frame's body (T_0_k, the first the identity), chained
 /// from consecutive relative poses; `failure` names the first pair that did not give one.
 struct StereoTrajectory {

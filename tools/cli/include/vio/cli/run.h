@@ -90,6 +90,13 @@ struct CalibrationReport {
   Eigen::Vector3d extrinsics_rotation_deg = Eigen::Vector3d::Zero();
   Eigen::Vector3d extrinsics_translation_m = Eigen::Vector3d::Zero();
   std::optional<double> extrinsics_rotation_sigma_deg, extrinsics_translation_sigma_m;
+  /// The rig rotation search at initialization (extrinsics_rotation_search), when it decided: the
+  /// rig's turn it found (body frame) [deg], its largest sigma [deg], whether the motion told it, and
+  /// whether the run started again with sensor.yaml's cameras turned by it.
+  std::optional<Eigen::Vector3d> rig_rotation_search_deg;
+  double rig_rotation_search_sigma_deg = 0;
+  bool rig_rotation_search_excited = false;
+  bool rig_rotation_search_restarted = false;
 };
 
 struct RunResult {
