@@ -1,19 +1,22 @@
 #include "vio/estimator/stereo_calibration_factor.h"
 
+#include <Eigen/LU>
+
 namespace vio {
 
 StereoCalibrationFactor::StereoCalibrationFactor(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo,
                                                  double sigma_px, const TimeOffset* time_offset, bool extrinsics)
     : plain_(z_px, stereo, sigma_px),  // throws on sigma_px <= 0
       extrinsic_(z_px, stereo, sigma_px),
+      stereo_(stereo),
+      sigma_px_(sigma_px),
       has_time_offset_(time_offset != nullptr),
       has_extrinsics_(extrinsics) {
   set_num_residuals(3);
   *mutable_parameter_block_sizes() = {7, 3};
   if (has_time_offset_) {
     mutable_parameter_block_sizes()->push_back(1);
-    whitened_velocity_ = time_offset->velocity_px_s / sigma_px;
-    applied_offset_s_ = time_offset->applied_offset_s;
+    time_offset_ = *time_offset;
   }
   if (has_extrinsics_) mutable_parameter_block_sizes()->push_back(6);
 }
@@ -29,7 +32,6 @@ bool StereoCalibrationFactor::EvaluateOnTangents(double const* const* parameters
 
 bool StereoCalibrationFactor::EvaluateImpl(double const* const* parameters, double* residuals, double** jacobians,
                                            bool on_tangents) const {
-  const int time_offset = 2;
   const int extrinsics = has_time_offset_ ? 3 : 2;
   const double* inner_parameters[3] = {parameters[0], parameters[1], has_extrinsics_ ? parameters[extrinsics] : nullptr};
   double* inner_jacobians[3] = {nullptr, nullptr, nullptr};
@@ -44,11 +46,38 @@ bool StereoCalibrationFactor::EvaluateImpl(double const* const* parameters, doub
   const bool ok = on_tangents ? tangent.EvaluateOnTangents(inner_parameters, residuals, inner)
                               : stereo.Evaluate(inner_parameters, residuals, inner);
   if (!ok || !has_time_offset_) return ok;
-  Eigen::Map<Eigen::Vector3d>{residuals} += (parameters[time_offset][0] - applied_offset_s_) * whitened_velocity_;
-  if (jacobians != nullptr && jacobians[time_offset] != nullptr) {
-    Eigen::Map<Eigen::Vector3d>{jacobians[time_offset]} = whitened_velocity_;
-  }
+  AddTimeOffset(parameters, residuals, jacobians, on_tangents);
   return true;
+}
+
+void StereoCalibrationFactor::AddTimeOffset(double const* const* parameters, double* residuals, double** jacobians,
+                                            bool on_tangents) const {
+  const int time_offset = 2;
+  const RectifiedStereo rig =
+      has_extrinsics_ ? CorrectedStereo(stereo_, Eigen::Map<const Eigen::Matrix<double, 6, 1>>(parameters[3])) : stereo_;
+  const Eigen::Map<const Eigen::Vector3d> p_w_b(parameters[0]);
+  const Eigen::Quaterniond q_w_b = Eigen::Map<const Eigen::Quaterniond>(parameters[0] + 3).normalized();
+  const Eigen::Map<const Eigen::Vector3d> p_w_l(parameters[1]);
+  const Eigen::Vector3d p_b = q_w_b.conjugate() * (p_w_l - p_w_b);
+  const Eigen::Vector3d p_c = rig.T_b_cl.linear().transpose() * (p_b - rig.T_b_cl.translation());
+  Eigen::Matrix3d dv_dp_c;
+  const Eigen::Vector3d velocity = ImageVelocity(p_c, time_offset_.motion, rig, &dv_dp_c);
+  const double dt = parameters[time_offset][0] - time_offset_.applied_offset_s;
+  Eigen::Map<Eigen::Vector3d>{residuals} += (dt / sigma_px_) * velocity;
+  if (jacobians == nullptr) return;
+  if (jacobians[time_offset] != nullptr) Eigen::Map<Eigen::Vector3d>{jacobians[time_offset]} = velocity / sigma_px_;
+  if (dt == 0.0) return;
+  // The blocks reach e through p_c only: de_h/dx = -(1/sigma) dh/dp_c dp_c/dx.
+  const Eigen::Matrix3d chain =
+      Eigen::Matrix3d::Identity() - dt * dv_dp_c * RectifiedProjectionJacobian(p_c, rig).inverse();
+  using RowMajor3 = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>;
+  const int pose_size = on_tangents ? 6 : 7;
+  const int sizes[4] = {pose_size, 3, 0, 6};
+  for (int block : {0, 1, has_extrinsics_ ? 3 : -1}) {
+    if (block < 0 || jacobians[block] == nullptr) continue;
+    Eigen::Map<RowMajor3> J(jacobians[block], 3, sizes[block]);
+    J = (chain * J).eval();
+  }
 }
 
 }  // namespace vio
