@@ -25,7 +25,7 @@ struct LoggedState {
   /// With the time offset estimated: the offset the state's time was made with [s] and the
   /// camera's motion at the state (Window::SetCameraTiming).
   double applied_offset_s = 0;
-  CameraMotion camera_motion;
+  CameraMotion camera_motion{};
 };
 
 /// The time offset as the online window estimated it: its prior, and its estimate at the end.
