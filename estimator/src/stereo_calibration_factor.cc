@@ -1,8 +1,29 @@
 #include "vio/estimator/stereo_calibration_factor.h"
 
-#include <Eigen/LU>
-
 namespace vio {
+namespace {
+
+/// (dh/dp_c)^-1 of the rectified projection at p_c (b != 0): from the disparity's row,
+/// dz = -z^2 / (f b) (du_L - du_R), then dx = (z / f) du_L + (x / z) dz, dy = (z / f) dv + (y / z) dz.
+Eigen::Matrix3d InverseRectifiedProjectionJacobian(const Eigen::Vector3d& p_c, const RectifiedStereo& stereo) {
+  const double z_f = p_c.z() / stereo.f;
+  const double z_fb = z_f / stereo.baseline;
+  Eigen::Matrix3d inverse;
+  inverse << z_f - p_c.x() * z_fb, p_c.x() * z_fb, 0.0,
+             -p_c.y() * z_fb, p_c.y() * z_fb, z_f,
+             -p_c.z() * z_fb, p_c.z() * z_fb, 0.0;
+  return inverse;
+}
+
+/// J <- chain J for a row-major 3 x N Jacobian.
+template <int N>
+void ChainInto(const Eigen::Matrix3d& chain, double* jacobian) {
+  Eigen::Map<Eigen::Matrix<double, 3, N, Eigen::RowMajor>> J(jacobian);
+  const Eigen::Matrix<double, 3, N, Eigen::RowMajor> chained = chain * J;
+  J = chained;
+}
+
+}  // namespace
 
 StereoCalibrationFactor::StereoCalibrationFactor(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo,
                                                  double sigma_px, const TimeOffset* time_offset, bool extrinsics)
@@ -53,15 +74,17 @@ bool StereoCalibrationFactor::EvaluateImpl(double const* const* parameters, doub
 void StereoCalibrationFactor::AddTimeOffset(double const* const* parameters, double* residuals, double** jacobians,
                                             bool on_tangents) const {
   const int time_offset = 2;
-  const RectifiedStereo rig =
-      has_extrinsics_ ? CorrectedStereo(stereo_, Eigen::Map<const Eigen::Matrix<double, 6, 1>>(parameters[3])) : stereo_;
+  const RectifiedStereo corrected =
+      has_extrinsics_ ? CorrectedStereo(stereo_, Eigen::Map<const Eigen::Matrix<double, 6, 1>>(parameters[3]))
+                      : RectifiedStereo{};
+  const RectifiedStereo& rig = has_extrinsics_ ? corrected : stereo_;
   const Eigen::Map<const Eigen::Vector3d> p_w_b(parameters[0]);
   const Eigen::Quaterniond q_w_b = Eigen::Map<const Eigen::Quaterniond>(parameters[0] + 3).normalized();
   const Eigen::Map<const Eigen::Vector3d> p_w_l(parameters[1]);
   const Eigen::Vector3d p_b = q_w_b.conjugate() * (p_w_l - p_w_b);
   const Eigen::Vector3d p_c = rig.T_b_cl.linear().transpose() * (p_b - rig.T_b_cl.translation());
   Eigen::Matrix3d dv_dp_c;
-  const Eigen::Vector3d velocity = ImageVelocity(p_c, time_offset_.motion, rig, &dv_dp_c);
+  const Eigen::Vector3d velocity = ImageVelocity(p_c, time_offset_.motion, rig, jacobians != nullptr ? &dv_dp_c : nullptr);
   const double dt = parameters[time_offset][0] - time_offset_.applied_offset_s;
   Eigen::Map<Eigen::Vector3d>{residuals} += (dt / sigma_px_) * velocity;
   if (jacobians == nullptr) return;
@@ -69,15 +92,16 @@ void StereoCalibrationFactor::AddTimeOffset(double const* const* parameters, dou
   if (dt == 0.0) return;
   // The blocks reach e through p_c only: de_h/dx = -(1/sigma) dh/dp_c dp_c/dx.
   const Eigen::Matrix3d chain =
-      Eigen::Matrix3d::Identity() - dt * dv_dp_c * RectifiedProjectionJacobian(p_c, rig).inverse();
-  using RowMajor3 = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>;
-  const int pose_size = on_tangents ? 6 : 7;
-  const int sizes[4] = {pose_size, 3, 0, 6};
-  for (int block : {0, 1, has_extrinsics_ ? 3 : -1}) {
-    if (block < 0 || jacobians[block] == nullptr) continue;
-    Eigen::Map<RowMajor3> J(jacobians[block], 3, sizes[block]);
-    J = (chain * J).eval();
+      Eigen::Matrix3d::Identity() - dt * dv_dp_c * InverseRectifiedProjectionJacobian(p_c, rig);
+  if (jacobians[0] != nullptr) {
+    if (on_tangents) {
+      ChainInto<6>(chain, jacobians[0]);
+    } else {
+      ChainInto<7>(chain, jacobians[0]);
+    }
   }
+  if (jacobians[1] != nullptr) ChainInto<3>(chain, jacobians[1]);
+  if (has_extrinsics_ && jacobians[3] != nullptr) ChainInto<6>(chain, jacobians[3]);
 }
 
 }  // namespace vio

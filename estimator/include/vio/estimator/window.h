@@ -112,7 +112,7 @@ class Window {
   Landmark& AddLandmark(LandmarkId id, const Eigen::Vector3d& p_w);
   /// Stereo observation z = (u_L, u_R, v) [px] of `landmark` from `state`; with a calibration block
   /// estimated, a StereoCalibrationFactor on it (the time offset's with the camera motion
-  /// SetCameraTiming gave, none if none).
+  /// SetCameraTiming gave; at rest if none).
   void AddObservation(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px);
 
   // ---- calibration: the camera-IMU time offset -------------------------------
