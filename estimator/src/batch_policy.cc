@@ -16,8 +16,6 @@ PolicyTiming BatchPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
     if (window.HasLandmark(obs.landmark)) window.SetLandmarkConstant(obs.landmark, false);
   }
   AddStereoObservations(frame, new_state, options_.model, window);
-  // Batch keeps every observation: the velocities, one per observation, live on in its factors only.
-  window.ReleaseImageVelocities(new_state);
   // A frozen state's bias no longer moves: its IMU factor was last checked by the refresh after
   // the solve it froze at.
   window.RefreshImuFactors(options_.model.reintegrate_bias_threshold, refresh_from_);

@@ -54,21 +54,15 @@ double Estimator::time_offset_s() const {
 
 Timestamp Estimator::AppliedTimeOffsetNs() const { return SecondsToNanos(time_offset_s()); }
 
-std::map<LandmarkId, Eigen::Vector3d> Estimator::ImageVelocities(const StereoFrame& frame) const {
-  std::map<LandmarkId, Eigen::Vector3d> velocity;
+CameraMotion Estimator::NewestCameraMotion() const {
   const State& s = window_.state(last_state_);
   // The bias-corrected gyro at the frame: the IMU sample nearest its time.
   const auto after = std::lower_bound(imu_.begin(), imu_.end(), s.t_ns,
                                       [](const ImuSample& m, Timestamp t) { return m.t_ns < t; });
-  if (imu_.empty()) return velocity;
+  if (imu_.empty()) return CameraMotion{};
   auto nearest = after == imu_.end() ? std::prev(after) : after;
   if (nearest != imu_.begin() && s.t_ns - std::prev(nearest)->t_ns < nearest->t_ns - s.t_ns) nearest = std::prev(nearest);
-  const Eigen::Vector3d omega_b = nearest->gyro_rad_s - s.gyro_bias();
-  for (const StereoObservation& obs : frame.observations) {
-    velocity.emplace(obs.landmark, ImageVelocity(obs.z_px, window_.estimated_stereo(), s.q_w_b(), s.v_w_b(), omega_b,
-                                                 options_.model.min_disparity_px, options_.model.max_depth_m));
-  }
-  return velocity;
+  return CameraMotionOf(window_.estimated_stereo(), s.q_w_b(), s.v_w_b(), nearest->gyro_rad_s - s.gyro_bias());
 }
 
 void Estimator::AddImu(const ImuSample& sample) {
@@ -102,16 +96,16 @@ FrameEstimate Estimator::ProcessFrame(const StereoFrame& camera_frame) {
     AddPropagatedState(frame.t_ns);
   }
   if (window_.estimates_time_offset()) {
-    std::map<LandmarkId, Eigen::Vector3d> velocities = ImageVelocities(frame);
+    const CameraMotion motion = NewestCameraMotion();
     if (log_) {
       if (!log_->time_offset) {
         log_->time_offset = LoggedTimeOffset{1e-3 * options_.model.time_offset_prior_mean_ms,
                                              1e-3 * options_.model.time_offset_prior_sigma_ms, 0.0};
       }
       log_->states.back().applied_offset_s = applied_offset_s;
-      log_->states.back().velocity_px_s = velocities;
+      log_->states.back().camera_motion = motion;
     }
-    window_.SetCameraTiming(last_state_, applied_offset_s, std::move(velocities));
+    window_.SetCameraTiming(last_state_, applied_offset_s, motion);
   }
   timing.propagate_ms = MillisecondsSince(start);
   const bool tracked = tracking_.Observe(frame.t_ns, static_cast<int>(frame.observations.size()));

@@ -53,7 +53,7 @@ void AddStates(const MeasurementLog& log, const StartValue& start, const Estimat
     } else if (logged.imu) {
       whole.AddImuFactor(previous->id, logged.id, *logged.imu);
     }
-    if (log.time_offset) whole.SetCameraTiming(logged.id, logged.applied_offset_s, logged.velocity_px_s);
+    if (log.time_offset) whole.SetCameraTiming(logged.id, logged.applied_offset_s, logged.camera_motion);
     previous = &s;
   }
 }

@@ -1,19 +1,43 @@
 #include "vio/estimator/stereo_calibration_factor.h"
 
 namespace vio {
+namespace {
+
+/// (dh/dp_c)^-1 of the rectified projection at p_c (b != 0): from the disparity's row,
+/// dz = -z^2 / (f b) (du_L - du_R), then dx = (z / f) du_L + (x / z) dz, dy = (z / f) dv + (y / z) dz.
+Eigen::Matrix3d InverseRectifiedProjectionJacobian(const Eigen::Vector3d& p_c, const RectifiedStereo& stereo) {
+  const double z_f = p_c.z() / stereo.f;
+  const double z_fb = z_f / stereo.baseline;
+  Eigen::Matrix3d inverse;
+  inverse << z_f - p_c.x() * z_fb, p_c.x() * z_fb, 0.0,
+             -p_c.y() * z_fb, p_c.y() * z_fb, z_f,
+             -p_c.z() * z_fb, p_c.z() * z_fb, 0.0;
+  return inverse;
+}
+
+/// J <- chain J for a row-major 3 x N Jacobian.
+template <int N>
+void ChainInto(const Eigen::Matrix3d& chain, double* jacobian) {
+  Eigen::Map<Eigen::Matrix<double, 3, N, Eigen::RowMajor>> J(jacobian);
+  const Eigen::Matrix<double, 3, N, Eigen::RowMajor> chained = chain * J;
+  J = chained;
+}
+
+}  // namespace
 
 StereoCalibrationFactor::StereoCalibrationFactor(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo,
                                                  double sigma_px, const TimeOffset* time_offset, bool extrinsics)
     : plain_(z_px, stereo, sigma_px),  // throws on sigma_px <= 0
       extrinsic_(z_px, stereo, sigma_px),
+      stereo_(stereo),
+      sigma_px_(sigma_px),
       has_time_offset_(time_offset != nullptr),
       has_extrinsics_(extrinsics) {
   set_num_residuals(3);
   *mutable_parameter_block_sizes() = {7, 3};
   if (has_time_offset_) {
     mutable_parameter_block_sizes()->push_back(1);
-    whitened_velocity_ = time_offset->velocity_px_s / sigma_px;
-    applied_offset_s_ = time_offset->applied_offset_s;
+    time_offset_ = *time_offset;
   }
   if (has_extrinsics_) mutable_parameter_block_sizes()->push_back(6);
 }
@@ -29,7 +53,6 @@ bool StereoCalibrationFactor::EvaluateOnTangents(double const* const* parameters
 
 bool StereoCalibrationFactor::EvaluateImpl(double const* const* parameters, double* residuals, double** jacobians,
                                            bool on_tangents) const {
-  const int time_offset = 2;
   const int extrinsics = has_time_offset_ ? 3 : 2;
   const double* inner_parameters[3] = {parameters[0], parameters[1], has_extrinsics_ ? parameters[extrinsics] : nullptr};
   double* inner_jacobians[3] = {nullptr, nullptr, nullptr};
@@ -44,11 +67,41 @@ bool StereoCalibrationFactor::EvaluateImpl(double const* const* parameters, doub
   const bool ok = on_tangents ? tangent.EvaluateOnTangents(inner_parameters, residuals, inner)
                               : stereo.Evaluate(inner_parameters, residuals, inner);
   if (!ok || !has_time_offset_) return ok;
-  Eigen::Map<Eigen::Vector3d>{residuals} += (parameters[time_offset][0] - applied_offset_s_) * whitened_velocity_;
-  if (jacobians != nullptr && jacobians[time_offset] != nullptr) {
-    Eigen::Map<Eigen::Vector3d>{jacobians[time_offset]} = whitened_velocity_;
-  }
+  AddTimeOffset(parameters, residuals, jacobians, on_tangents);
   return true;
+}
+
+void StereoCalibrationFactor::AddTimeOffset(double const* const* parameters, double* residuals, double** jacobians,
+                                            bool on_tangents) const {
+  const int time_offset = 2;
+  const RectifiedStereo corrected =
+      has_extrinsics_ ? CorrectedStereo(stereo_, Eigen::Map<const Eigen::Matrix<double, 6, 1>>(parameters[3]))
+                      : RectifiedStereo{};
+  const RectifiedStereo& rig = has_extrinsics_ ? corrected : stereo_;
+  const Eigen::Map<const Eigen::Vector3d> p_w_b(parameters[0]);
+  const Eigen::Quaterniond q_w_b = Eigen::Map<const Eigen::Quaterniond>(parameters[0] + 3).normalized();
+  const Eigen::Map<const Eigen::Vector3d> p_w_l(parameters[1]);
+  const Eigen::Vector3d p_b = q_w_b.conjugate() * (p_w_l - p_w_b);
+  const Eigen::Vector3d p_c = rig.T_b_cl.linear().transpose() * (p_b - rig.T_b_cl.translation());
+  Eigen::Matrix3d dv_dp_c;
+  const Eigen::Vector3d velocity = ImageVelocity(p_c, time_offset_.motion, rig, jacobians != nullptr ? &dv_dp_c : nullptr);
+  const double dt = parameters[time_offset][0] - time_offset_.applied_offset_s;
+  Eigen::Map<Eigen::Vector3d>{residuals} += (dt / sigma_px_) * velocity;
+  if (jacobians == nullptr) return;
+  if (jacobians[time_offset] != nullptr) Eigen::Map<Eigen::Vector3d>{jacobians[time_offset]} = velocity / sigma_px_;
+  if (dt == 0.0) return;
+  // The blocks reach e through p_c only: de_h/dx = -(1/sigma) dh/dp_c dp_c/dx.
+  const Eigen::Matrix3d chain =
+      Eigen::Matrix3d::Identity() - dt * dv_dp_c * InverseRectifiedProjectionJacobian(p_c, rig);
+  if (jacobians[0] != nullptr) {
+    if (on_tangents) {
+      ChainInto<6>(chain, jacobians[0]);
+    } else {
+      ChainInto<7>(chain, jacobians[0]);
+    }
+  }
+  if (jacobians[1] != nullptr) ChainInto<3>(chain, jacobians[1]);
+  if (has_extrinsics_ && jacobians[3] != nullptr) ChainInto<6>(chain, jacobians[3]);
 }
 
 }  // namespace vio

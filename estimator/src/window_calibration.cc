@@ -80,14 +80,9 @@ void Window::SetCalibrationConstant(bool constant) {
   }
 }
 
-void Window::SetCameraTiming(StateId id, double applied_offset_s, std::map<LandmarkId, Eigen::Vector3d> velocity_px_s) {
+void Window::SetCameraTiming(StateId id, double applied_offset_s, const CameraMotion& motion) {
   CHECK(HasState(id)) << "camera timing of unknown state " << id.value;
-  camera_timing_[id] = CameraTiming{applied_offset_s, std::move(velocity_px_s)};
-}
-
-void Window::ReleaseImageVelocities(StateId id) {
-  const auto timing = camera_timing_.find(id);
-  if (timing != camera_timing_.end()) std::map<LandmarkId, Eigen::Vector3d>().swap(timing->second.velocity_px_s);
+  camera_timing_[id] = CameraTiming{applied_offset_s, motion};
 }
 
 std::optional<Eigen::MatrixXd> Window::CalibrationCovariance(const double* block) {
@@ -117,14 +112,13 @@ std::optional<Eigen::Matrix<double, 6, 6>> Window::ExtrinsicCovariance() {
   return Eigen::Matrix<double, 6, 6>(*covariance);
 }
 
-ceres::CostFunction* Window::StereoFactorOf(StateId state_id, LandmarkId landmark_id, const Eigen::Vector3d& z_px) const {
+ceres::CostFunction* Window::StereoFactorOf(StateId state_id, LandmarkId /*landmark_id*/, const Eigen::Vector3d& z_px) const {
   if (!estimates_time_offset() && !estimates_extrinsics()) return StereoFactor::Create(z_px, stereo_, model_.pixel_sigma);
   StereoCalibrationFactor::TimeOffset timing;
   const auto camera = camera_timing_.find(state_id);
   if (camera != camera_timing_.end()) {
     timing.applied_offset_s = camera->second.applied_offset_s;
-    const auto v = camera->second.velocity_px_s.find(landmark_id);
-    if (v != camera->second.velocity_px_s.end()) timing.velocity_px_s = v->second;
+    timing.motion = camera->second.motion;
   }
   return new StereoCalibrationFactor(z_px, stereo_, model_.pixel_sigma, estimates_time_offset() ? &timing : nullptr,
                                      estimates_extrinsics());

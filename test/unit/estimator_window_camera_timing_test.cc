@@ -1,11 +1,9 @@
-// Window::ReleaseImageVelocities (batch frees the image velocities once a
-// state's observations are added): the observations' factors keep their own,
-// so the cost with the time offset away from the applied one is unchanged to
-// the last bit, and it is not the cost without the velocities.
-#include <map>
-
+// Window::SetCameraTiming: a state's applied offset t_a and camera motion reach its observations'
+// factors: the window's cost, with the offset 4 ms from t_a, is that of StereoCalibrationFactors
+// made with them (to 1e-12), and the motion matters.
 #include <gtest/gtest.h>
 
+#include "vio/estimator/stereo_calibration_factor.h"
 #include "vio/estimator/stereo_factor.h"
 #include "vio/estimator/window.h"
 
@@ -13,40 +11,55 @@ namespace vio {
 namespace {
 
 const LandmarkId kLandmarks[] = {LandmarkId(1), LandmarkId(2)};
+const Eigen::Vector3d kPoints[] = {{0.3, -0.2, 4.0}, {-0.5, 0.4, 6.0}};
 
-// Two states seeing two landmarks with image velocities of 300 px/s, the offset 4 ms from the
-// applied one; released: the velocities dropped after the observations were added.
-double Cost(bool released, double velocity_px_s = 300.0) {
-  const ModelOptions model;
+CameraMotion Motion(double scale) {
+  CameraMotion motion;
+  motion.omega_c = scale * Eigen::Vector3d(0.3, -0.5, 0.2);
+  motion.v_c = scale * Eigen::Vector3d(0.8, 0.1, -0.4);
+  return motion;
+}
+
+// Two states seeing two landmarks (observed 0.5 px off their projections), the offset 4 ms from
+// the applied one (1 ms); direct: the same factors evaluated outside the window.
+double Cost(double motion_scale, bool direct) {
+  ModelOptions model;
+  model.huber_px = 0;
   const RectifiedStereo stereo;
   Window window(model, stereo);
   window.EstimateTimeOffset(0.0, 0.005);
-  window.SetTimeOffset(0.004);
-  const Eigen::Vector3d points[] = {{0.3, -0.2, 4.0}, {-0.5, 0.4, 6.0}};
-  for (int k = 0; k < 2; ++k) window.AddLandmark(kLandmarks[k], points[k]);
+  window.SetTimeOffset(0.005);
+  for (int k = 0; k < 2; ++k) window.AddLandmark(kLandmarks[k], kPoints[k]);
+  double cost = 0;
   for (int i = 0; i < 2; ++i) {
     const StateId id(i);
     State& s = window.AddState(id, 50'000'000LL * i);
     s.SetPose(Eigen::Vector3d(0.05 * i, 0, 0), Eigen::Quaterniond::Identity());
-    std::map<LandmarkId, Eigen::Vector3d> velocity;
-    for (LandmarkId landmark : kLandmarks) velocity[landmark] = Eigen::Vector3d(velocity_px_s, velocity_px_s, -velocity_px_s);
-    window.SetCameraTiming(id, 0.0, velocity);
+    const StereoCalibrationFactor::TimeOffset timing{Motion(motion_scale), 0.001};
+    window.SetCameraTiming(id, timing.applied_offset_s, timing.motion);
     for (int k = 0; k < 2; ++k) {
       Eigen::Vector3d z_px;
-      EXPECT_TRUE(StereoFactor::Project(stereo, s.p_w_b(), s.q_w_b(), points[k], &z_px));
+      EXPECT_TRUE(StereoFactor::Project(stereo, s.p_w_b(), s.q_w_b(), kPoints[k], &z_px));
+      z_px += Eigen::Vector3d(0.5, 0.5, -0.5);
       window.AddObservation(id, kLandmarks[k], z_px);
+      const StereoCalibrationFactor factor(z_px, stereo, model.pixel_sigma, &timing, false);
+      const double td = 0.005;
+      const double* parameters[3] = {s.pose, kPoints[k].data(), &td};
+      Eigen::Vector3d r;
+      EXPECT_TRUE(factor.Evaluate(parameters, r.data(), nullptr));
+      cost += 0.5 * r.squaredNorm();
     }
-    if (released) window.ReleaseImageVelocities(id);
   }
-  double cost = 0;
+  if (direct) return cost;
+  cost = 0;
   EXPECT_TRUE(window.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr));
-  return cost;
+  return cost - 0.5 * (0.005 / 0.005) * (0.005 / 0.005);  // without the offset's prior (1 sigma)
 }
 
-TEST(WindowCameraTiming, ReleasedVelocitiesLeaveTheCostUnchanged) {
-  const double kept = Cost(false);
-  EXPECT_EQ(Cost(true), kept);
-  EXPECT_GT(std::abs(kept - Cost(false, 0.0)), 1e-3 * kept);  // the velocities matter
+TEST(WindowCameraTiming, TheStatesMotionAndAppliedOffsetReachItsFactors) {
+  const double cost = Cost(1.0, false);
+  EXPECT_NEAR(cost, Cost(1.0, true), 1e-12 * cost);
+  EXPECT_GT(std::abs(cost - Cost(0.0, false)), 1e-3 * cost);  // the motion matters
 }
 
 }  // namespace

@@ -185,9 +185,9 @@ class Estimator {
   static FrameEstimate EstimateOfInitial(const InitialState& state);
   void PruneImu(Timestamp before_ns);
   Timestamp AppliedTimeOffsetNs() const;
-  /// The frame's image velocities [px/s] by landmark at the newest state's (IMU-predicted)
-  /// velocity and bias-corrected gyro rate (ImageVelocity).
-  std::map<LandmarkId, Eigen::Vector3d> ImageVelocities(const StereoFrame& frame) const;
+  /// The camera's motion at the newest state: its (IMU-predicted) velocity and the bias-corrected
+  /// gyro rate at its time (CameraMotionOf, the estimated rig).
+  CameraMotion NewestCameraMotion() const;
 
   EstimatorOptions options_;
   ImuCalibration imu_calibration_;

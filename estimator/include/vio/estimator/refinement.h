@@ -23,9 +23,9 @@ struct LoggedState {
   std::vector<StereoObservation> observations;  ///< after gating; empty when tracking was lost
   std::optional<ImuPreintegration> imu;          ///< from the previous logged state (none for the first)
   /// With the time offset estimated: the offset the state's time was made with [s] and the
-  /// observations' image velocities [px/s] (Window::SetCameraTiming).
+  /// camera's motion at the state (Window::SetCameraTiming).
   double applied_offset_s = 0;
-  std::map<LandmarkId, Eigen::Vector3d> velocity_px_s;
+  CameraMotion camera_motion{};
 };
 
 /// The time offset as the online window estimated it: its prior, and its estimate at the end.

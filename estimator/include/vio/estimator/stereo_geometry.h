@@ -5,6 +5,9 @@
 // so disparity d = u_L - u_R = f b / z.
 #include <optional>
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
 #include "vio/estimator/types.h"
 
 namespace vio {
@@ -17,12 +20,26 @@ std::optional<Eigen::Vector3d> TriangulateRectified(const Eigen::Vector3d& z_px,
 /// (u_L, u_R, v) of a point in the rectified left camera (z > 0 assumed).
 Eigen::Vector3d ProjectRectified(const Eigen::Vector3d& p_cl, const RectifiedStereo& stereo);
 
-/// d(u_L, u_R, v)/dt [px/s] of a static point seen at z_px (stereo-triangulated; at max_depth_m
-/// along its ray when its disparity is below min_disparity_px) from a body with orientation
-/// q_w_b, velocity v_w_b [m/s] and angular rate omega_b [rad/s, body]: first order, from
-/// dp_c/dt = R_c_b (-omega_b x p_b - R_b_w v_w_b).
-Eigen::Vector3d ImageVelocity(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo, const Eigen::Quaterniond& q_w_b,
-                              const Eigen::Vector3d& v_w_b, const Eigen::Vector3d& omega_b, double min_disparity_px,
-                              double max_depth_m);
+/// dh/dp_cl of ProjectRectified at p_cl (z > 0 assumed):
+///   f / z [[1, 0, -x / z], [1, 0, -(x - b) / z], [0, 1, -y / z]].
+Eigen::Matrix3d RectifiedProjectionJacobian(const Eigen::Vector3d& p_cl, const RectifiedStereo& stereo);
+
+/// The rectified left camera's motion at a frame, in its own frame: angular rate omega_c [rad/s]
+/// and linear velocity v_c [m/s]. A static point p_c moves as dp_c/dt = -omega_c x p_c - v_c.
+struct CameraMotion {
+  Eigen::Vector3d omega_c = Eigen::Vector3d::Zero();
+  Eigen::Vector3d v_c = Eigen::Vector3d::Zero();
+};
+
+/// The camera's motion of a body with orientation q_w_b, velocity v_w_b [m/s] and angular rate
+/// omega_b [rad/s, body]: omega_c = R_c_b omega_b, v_c = R_c_b (R_b_w v_w_b + omega_b x p_b_c).
+CameraMotion CameraMotionOf(const RectifiedStereo& stereo, const Eigen::Quaterniond& q_w_b, const Eigen::Vector3d& v_w_b,
+                            const Eigen::Vector3d& omega_b);
+
+/// d(u_L, u_R, v)/dt [px/s] of the static point p_cl (rectified left camera, z > 0) seen by a
+/// camera moving as `motion`: v = dh/dp_c (-omega_c x p_c - v_c). With d_dp_c, also dv/dp_c
+/// (the projection's second derivative along dp_c/dt, plus dh/dp_c (-[omega_c]x)).
+Eigen::Vector3d ImageVelocity(const Eigen::Vector3d& p_cl, const CameraMotion& motion, const RectifiedStereo& stereo,
+                              Eigen::Matrix3d* d_dp_c = nullptr);
 
 }  // namespace vio

@@ -1,7 +1,7 @@
 #pragma once
 // The coarse camera-IMU time offset search at initialization (docs/calibration.md): the gyro's
 // rotation against the stereo camera's, over frame pairs, for every offset on a grid. The online
-// estimate (StereoTimeOffsetFactor) is a linearization that converges from within a few of its
+// estimate (StereoCalibrationFactor) is a linearization that converges from within a few of its
 // prior sigmas; the search brings offsets up to its range there.
 #include <deque>
 #include <optional>

@@ -28,6 +28,7 @@
 #include "vio/estimator/gauss_newton.h"
 #include "vio/estimator/imu_preintegration.h"
 #include "vio/estimator/solve_control.h"
+#include "vio/estimator/stereo_geometry.h"
 #include "vio/estimator/types.h"
 #include "vio/marginalization/block_system.h"
 #include "vio/marginalization/marginalizer.h"
@@ -121,14 +122,14 @@ class Window {
   void AddStatePrior(StateId id, const StatePrior& prior);
   Landmark& AddLandmark(LandmarkId id, const Eigen::Vector3d& p_w);
   /// Stereo observation z = (u_L, u_R, v) [px] of `landmark` from `state`; with a calibration block
-  /// estimated, a StereoCalibrationFactor on it (the time offset's with the image velocity
-  /// SetCameraTiming gave, zero if none).
+  /// estimated, a StereoCalibrationFactor on it (the time offset's with the camera motion
+  /// SetCameraTiming gave; at rest if none).
   void AddObservation(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px);
 
   // ---- calibration: the camera-IMU time offset -------------------------------
   /// Makes the time offset t_d [s] (an image stamped t was taken at IMU time t - t_d) a parameter
   /// block of the window, under the prior N(mean_s, sigma_s^2), starting at the mean; every
-  /// observation added from now on depends on it (stereo_time_offset_factor.h). Once, before
+  /// observation added from now on depends on it (stereo_calibration_factor.h). Once, before
   /// the first observation.
   void EstimateTimeOffset(double mean_s, double sigma_s);
   bool estimates_time_offset() const { return time_offset_prior_.residual != nullptr; }
@@ -158,12 +159,9 @@ class Window {
   /// The rig with the estimated correction applied (the given rig when not estimated): what
   /// triangulation and gating use.
   RectifiedStereo estimated_stereo() const;
-  /// The offset t_a [s] the state's time was made with (its camera stamp minus t_ns) and its
-  /// observations' image velocities [px/s] by landmark: what its observations' factors use.
-  void SetCameraTiming(StateId state, double applied_offset_s, std::map<LandmarkId, Eigen::Vector3d> velocity_px_s);
-  /// Frees the image velocities SetCameraTiming kept for `state` (its observations' factors hold
-  /// their own): for a policy that adds no further observation from `state` (batch).
-  void ReleaseImageVelocities(StateId state);
+  /// The offset t_a [s] the state's time was made with (its camera stamp minus t_ns) and the
+  /// camera's motion at the state: what its observations' factors use (stereo_calibration_factor.h).
+  void SetCameraTiming(StateId state, double applied_offset_s, const CameraMotion& motion);
   /// The landmark measured in `anchor`'s body frame (AnchoredPointFactor, no loss): the local
   /// map's summary of the observations of frames it dropped. Replaces the pair's earlier one.
   void SetAnchoredPoint(StateId anchor, LandmarkId landmark, const Eigen::Vector3d& p_b_hat,
@@ -298,7 +296,7 @@ class Window {
   /// A state's camera timing (SetCameraTiming).
   struct CameraTiming {
     double applied_offset_s = 0;
-    std::map<LandmarkId, Eigen::Vector3d> velocity_px_s;
+    CameraMotion motion;
   };
   /// States and landmarks leaving the window (marginalized or dropped), and
   /// their parameter blocks.
