@@ -15,7 +15,6 @@ PolicyTiming SmootherPolicy::Update(const StereoFrame& frame, StateId new_state,
     if (window.HasLandmark(obs.landmark)) window.SetLandmarkConstant(obs.landmark, false);
   }
   AddStereoObservations(frame, new_state, options_.model, window);
-  window.ReleaseImageVelocities(new_state);
   FreeMoved(window);
   window.RefreshImuFactors(options_.model.reintegrate_bias_threshold, std::min(refresh_from_, *active_.begin()));
   timing.build_ms = MillisecondsSince(start);
