@@ -1,9 +1,9 @@
 // The rig rotation search at initialization end to end (docs/calibration.md): a synthetic flight
 // whose sensor.yaml has both cameras turned by 5 deg in the body (simulated with the true rig) is
 // found by the search, run again with the cameras turned and the extrinsics estimated online, and
-// ends with the rig within 0.2 deg of the truth and the accuracy of the clean flight with the extrinsics
-// estimated; on the clean flight
-// the search finds no turn beyond the prior and the trajectory is byte-identical to one without it.
+// ends with the rig within 0.2 deg of the truth and the accuracy of the clean flight with the
+// extrinsics estimated; on the clean flight the search finds no turn beyond the prior and the
+// trajectory is byte-identical to one without it.
 #include <cmath>
 #include <fstream>
 #include <sstream>
