@@ -12,10 +12,7 @@ PolicyTiming BatchPolicy::Update(const StereoFrame& frame, StateId new_state, Wi
   PolicyTiming timing;
   auto start = std::chrono::steady_clock::now();
   active_.insert(new_state);
-  for (const StereoObservation& obs : frame.observations) {
-    if (window.HasLandmark(obs.landmark)) window.SetLandmarkConstant(obs.landmark, false);
-  }
-  AddStereoObservations(frame, new_state, options_.model, window);
+  AddToKeptProblem(frame, new_state, options_.model, window);
   // A frozen state's bias no longer moves: its IMU factor was last checked by the refresh after
   // the solve it froze at.
   window.RefreshImuFactors(options_.model.reintegrate_bias_threshold, refresh_from_);

@@ -45,6 +45,13 @@ int AddStereoObservations(const StereoFrame& frame, StateId state_id, const Mode
   return added;
 }
 
+void AddToKeptProblem(const StereoFrame& frame, StateId state, const ModelOptions& model, Window& window) {
+  for (const StereoObservation& obs : frame.observations) {
+    if (window.HasLandmark(obs.landmark)) window.SetLandmarkConstant(obs.landmark, false);
+  }
+  AddStereoObservations(frame, state, model, window);
+}
+
 PolicyTiming AddFrameAndSolve(const StereoFrame& frame, StateId state, const EstimatorOptions& options,
                               Window& window) {
   PolicyTiming timing;

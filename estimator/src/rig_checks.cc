@@ -75,29 +75,32 @@ std::string CheckBiases(const Eigen::Vector3d& gyro_bias, const Eigen::Vector3d&
   return why.str();
 }
 
-Eigen::Vector3d IntegratedGyro(const std::vector<ImuSample>& imu, Timestamp t0_ns, Timestamp t1_ns) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+namespace {
+
+// Calls visit(mean rate [rad/s], dt [s]) for each IMU interval's part within [t0, t1], in order.
+template <typename Visit>
+void ForEachGyroInterval(const std::vector<ImuSample>& imu, Timestamp t0_ns, Timestamp t1_ns, Visit visit) {
   const auto first = std::lower_bound(imu.begin(), imu.end(), t0_ns,
                                       [](const ImuSample& m, Timestamp t) { return m.t_ns < t; });
   for (auto i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(1, first - imu.begin()));
        i < imu.size() && imu[i - 1].t_ns < t1_ns; ++i) {
     const Timestamp from = std::max(imu[i - 1].t_ns, t0_ns), to = std::min(imu[i].t_ns, t1_ns);
-    if (to <= from) continue;
-    sum += 0.5 * (imu[i - 1].gyro_rad_s + imu[i].gyro_rad_s) * NanosToSeconds(to - from);
+    if (to > from) visit(0.5 * (imu[i - 1].gyro_rad_s + imu[i].gyro_rad_s), NanosToSeconds(to - from));
   }
+}
+
+}  // namespace
+
+Eigen::Vector3d IntegratedGyro(const std::vector<ImuSample>& imu, Timestamp t0_ns, Timestamp t1_ns) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  ForEachGyroInterval(imu, t0_ns, t1_ns, [&sum](const Eigen::Vector3d& rate, double dt) { sum += rate * dt; });
   return sum;
 }
 
 Eigen::Quaterniond IntegratedRotation(const std::vector<ImuSample>& imu, Timestamp t0_ns, Timestamp t1_ns) {
   Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
-  const auto first = std::lower_bound(imu.begin(), imu.end(), t0_ns,
-                                      [](const ImuSample& m, Timestamp t) { return m.t_ns < t; });
-  for (auto i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(1, first - imu.begin()));
-       i < imu.size() && imu[i - 1].t_ns < t1_ns; ++i) {
-    const Timestamp from = std::max(imu[i - 1].t_ns, t0_ns), to = std::min(imu[i].t_ns, t1_ns);
-    if (to <= from) continue;
-    q = q * so3::ExpQuaternion(0.5 * (imu[i - 1].gyro_rad_s + imu[i].gyro_rad_s) * NanosToSeconds(to - from));
-  }
+  ForEachGyroInterval(imu, t0_ns, t1_ns,
+                      [&q](const Eigen::Vector3d& rate, double dt) { q = q * so3::ExpQuaternion(rate * dt); });
   return q.normalized();
 }
 

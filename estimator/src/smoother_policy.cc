@@ -11,10 +11,7 @@ PolicyTiming SmootherPolicy::Update(const StereoFrame& frame, StateId new_state,
   PolicyTiming timing;
   auto start = std::chrono::steady_clock::now();
   active_.insert(new_state);
-  for (const StereoObservation& obs : frame.observations) {
-    if (window.HasLandmark(obs.landmark)) window.SetLandmarkConstant(obs.landmark, false);
-  }
-  AddStereoObservations(frame, new_state, options_.model, window);
+  AddToKeptProblem(frame, new_state, options_.model, window);
   FreeMoved(window);
   window.RefreshImuFactors(options_.model.reintegrate_bias_threshold, std::min(refresh_from_, *active_.begin()));
   timing.build_ms = MillisecondsSince(start);

@@ -54,6 +54,11 @@ inline double MillisecondsSince(std::chrono::steady_clock::time_point start) {
 int AddStereoObservations(const StereoFrame& frame, StateId state, const ModelOptions& model, Window& window,
                           int max_landmarks = 0);
 
+/// The frame step of the policies that keep every landmark (batch, smoother):
+/// the landmarks the frame sees, held constant since, are freed, then its
+/// observations are added (AddStereoObservations).
+void AddToKeptProblem(const StereoFrame& frame, StateId state, const ModelOptions& model, Window& window);
+
 /// The sliding-window frame step: the frame's observations in (new
 /// landmarks stereo-triangulated), IMU factors refreshed, then Gauss-Newton
 /// steps; returns the build and solve timings.
