@@ -3,13 +3,16 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <vector>
 
 #include <glog/logging.h>
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "correlation_peak.h"
+#include "vio/frontend/fixed_point_remap.h"
 
 namespace vio::frontend {
 namespace {
@@ -21,6 +24,39 @@ using detail::ParabolaVertex;
 
 /// Samples per image side when bounding the rectified images [count].
 constexpr int kBorderSamples = 64;
+
+// Per window position x, sum over the template of T(r, c) S(r, x + c), in
+// integers (the same result in any order): per template row, two template
+// columns at a time against eight positions, each pair of products summed by
+// one 16-bit multiply-add (grey levels fit in 16 bits, their products and
+// sums in 32).
+std::vector<int> CrossSums(const cv::Mat& strip, const cv::Mat& templ, int positions) {
+  const int n = templ.rows;
+  // Eight positions per step, and the second column of the last odd pair
+  // (weight 0) read one past: the buffers are padded for both.
+  const int padded = (positions + 7) / 8 * 8;
+  std::vector<int> cross(static_cast<size_t>(padded), 0);
+  std::vector<std::int16_t> row16(static_cast<size_t>(padded + n + 1), 0);
+  for (int r = 0; r < n; ++r) {
+    const uchar* row = strip.ptr<uchar>(r);
+    for (int x = 0; x < strip.cols; ++x) row16[static_cast<size_t>(x)] = row[x];
+    const uchar* t = templ.ptr<uchar>(r);
+    for (int c = 0; c < n; c += 2) {
+      const int second = c + 1 < n ? t[c + 1] : 0;
+      const cv::v_int16x8 weights = cv::v_reinterpret_as_s16(cv::v_setall_s32(t[c] | (second << 16)));
+      const std::int16_t* from = row16.data() + c;
+      for (int x = 0; x < padded; x += 8) {
+        cv::v_int16x8 pairs_low, pairs_high;
+        cv::v_zip(cv::v_load(from + x), cv::v_load(from + x + 1), pairs_low, pairs_high);
+        int* sums = cross.data() + x;
+        cv::v_store(sums, cv::v_dotprod(pairs_low, weights, cv::v_load(sums)));
+        cv::v_store(sums + 4, cv::v_dotprod(pairs_high, weights, cv::v_load(sums + 4)));
+      }
+    }
+  }
+  cross.resize(static_cast<size_t>(positions));
+  return cross;
+}
 
 // ZNCC of the square template against each window of the strip (both
 // CV_8UC1 with the template's rows), one score per window position, from
@@ -49,20 +85,7 @@ std::vector<float> ZnccAlongStrip(const cv::Mat& strip, const cv::Mat& templ) {
     }
   }
   const int positions = strip.cols - n + 1;
-  // sum over the window of T * S, per window position: one pass over the
-  // positions per template pixel, so the inner loop runs over contiguous
-  // pixels (integer sums: the same result in any order).
-  std::vector<int> cross_sums(static_cast<size_t>(positions), 0);
-  for (int r = 0; r < n; ++r) {
-    const uchar* row = strip.ptr<uchar>(r);
-    const uchar* t = templ.ptr<uchar>(r);
-    for (int c = 0; c < n; ++c) {
-      const int weight = t[c];
-      const uchar* from = row + c;
-      int* cross = cross_sums.data();
-      for (int x = 0; x < positions; ++x) cross[x] += weight * from[x];
-    }
-  }
+  const std::vector<int> cross_sums = CrossSums(strip, templ, positions);
   std::vector<float> scores(static_cast<size_t>(positions), 0.0f);
   for (int x = 0; x < positions; ++x) {
     int sum = 0, sum2 = 0;
@@ -138,7 +161,7 @@ void StereoRowSearch::BuildMaps(const StereoRectifier& rectifier, int camera) {
 
 cv::Mat StereoRowSearch::Rectified(int camera, const cv::Mat& raw, const cv::Rect& roi) const {
   cv::Mat patch;
-  cv::remap(raw, patch, map_xy_[camera](roi), map_frac_[camera](roi), cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  RemapLinear(raw, map_xy_[camera](roi), map_frac_[camera](roi), &patch);
   return patch;
 }
 

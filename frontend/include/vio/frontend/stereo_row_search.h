@@ -14,8 +14,9 @@
 //             along the row is ambiguous);
 //   refine    d = the vertex of the parabola through the scores at d* - 1,
 //             d*, d* + 1; only d > 0 is returned.
-// Only the patches needed are rectified: cv::remap on sub-rectangles of
-// fixed-point rectification maps computed once. The maps cover the whole raw
+// Only the patches needed are rectified: cv::remap's interpolation
+// (RemapLinear, fixed_point_remap.h) on sub-rectangles of fixed-point
+// rectification maps computed once. The maps cover the whole raw
 // images (a rectified canvas larger than StereoRectifier's cropped one), so
 // features near the raw border are searched too; only canvas pixels that
 // fall inside the raw image are compared.
