@@ -14,10 +14,12 @@ constexpr double kMaxDisparityPx = 128;
 constexpr double kMinNcc = 0.85;
 constexpr double kCornerQuality = 0.01;
 constexpr double kCornerSpacingPx = 20;
-/// The corners are sought on the image shrunk by this factor: the corner
-/// measure of the full 752x480 image cost 35 M instructions per image (as
-/// much as the KLT front end's whole frame), a quarter of it on the half
-/// image; the row search then compares full-resolution patches [count].
+/// The corners are sought on the image shrunk by this factor (the row search
+/// then compares full-resolution patches): goodFeaturesToTrack on a whole
+/// 752x480 image costs 35 M instructions, two per pair, more than the KLT
+/// front end's tracking of a frame; on the half image 8 M. On the real clips
+/// the matches as given / exchanged are 244/14 (static) and 261/12 (flight)
+/// against 240/14 and 266/7 on the whole image [count].
 constexpr int kCornerShrink = 2;
 
 }  // namespace
