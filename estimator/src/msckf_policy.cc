@@ -279,8 +279,11 @@ std::vector<LandmarkId> MsckfPolicy::AddTriangulated(const std::vector<TrackUpda
   triangulation.max_reprojection_sigma = MostReprojectionError(options_);
   triangulation.max_position_sigma_m = options_.msckf.msckf_max_landmark_sigma;
   std::vector<TriangulationResult> results;
+  results.reserve(updates.size());
+  std::vector<StereoView> views;
   for (const TrackUpdate& update : updates) {
-    std::vector<StereoView> views;
+    views.clear();
+    views.reserve(update.observations.size());
     for (const auto& [state, z] : update.observations) views.push_back({BodyPose(window.state(state)), z});
     results.push_back(TriangulateMultiView(views, window.estimated_stereo(), triangulation));
   }

@@ -1,5 +1,7 @@
 #include "vio/estimator/triangulation.h"
 
+#include <vector>
+
 #include <Eigen/Eigenvalues>
 #include <glog/logging.h>
 
@@ -8,12 +10,12 @@
 namespace vio {
 namespace {
 
-// Residual (z - h) / sigma of one view and its Jacobian with respect to p_w;
-// false when the point is not in front of the camera.
-bool ViewResidual(const StereoView& view, const Eigen::Isometry3d& T_cl_b, const RectifiedStereo& stereo,
+// Residual (z - h) / sigma of one view (seen from the left camera at T_cl_w)
+// and its Jacobian with respect to p_w; false when the point is not in front
+// of the camera.
+bool ViewResidual(const StereoView& view, const Eigen::Isometry3d& T_cl_w, const RectifiedStereo& stereo,
                   const Eigen::Vector3d& p_w, double inv_sigma, double min_depth, Eigen::Vector3d* r,
                   Eigen::Matrix3d* J) {
-  const Eigen::Isometry3d T_cl_w = T_cl_b * view.T_w_b.inverse();
   const Eigen::Vector3d p = T_cl_w * p_w;
   if (p.z() < min_depth) return false;
   *r = (view.z_px - ProjectRectified(p, stereo)) * inv_sigma;
@@ -46,6 +48,10 @@ TriangulationResult TriangulateMultiView(const std::vector<StereoView>& views, c
   std::optional<Eigen::Vector3d> p_w = InitialGuess(views, stereo);
   if (!p_w) return {std::nullopt, TriangulationFailure::kNoDisparity};
   const Eigen::Isometry3d T_cl_b = stereo.T_b_cl.inverse();
+  // Each view's world-to-camera transform, once for every iteration.
+  std::vector<Eigen::Isometry3d> T_cl_w;
+  T_cl_w.reserve(views.size());
+  for (const StereoView& view : views) T_cl_w.push_back(T_cl_b * view.T_w_b.inverse());
   const double inv_sigma = 1.0 / options.pixel_sigma;
   Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
   Eigen::Vector3d r, g;
@@ -55,8 +61,8 @@ TriangulationResult TriangulateMultiView(const std::vector<StereoView>& views, c
     H.setZero();
     g.setZero();
     max_error = 0;
-    for (const StereoView& view : views) {
-      if (!ViewResidual(view, T_cl_b, stereo, *p_w, inv_sigma, options.min_depth_m, &r, &J)) {
+    for (std::size_t v = 0; v < views.size(); ++v) {
+      if (!ViewResidual(views[v], T_cl_w[v], stereo, *p_w, inv_sigma, options.min_depth_m, &r, &J)) {
         return {std::nullopt, TriangulationFailure::kBehindCamera};
       }
       H += J.transpose() * J;

@@ -166,11 +166,23 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
   const ObservationKey key{state_id, landmark_id};
   CHECK(observations_.count(key) == 0) << "landmark " << landmark_id.value << " observed twice in state "
                                       << state_id.value;
-  std::vector<double*> blocks = {s.pose, it->second.p_w};
-  std::vector<BlockKey> keys = {BlockKey::Pose(state_id), BlockKey::Landmark(landmark_id)};
-  for (double* block : CalibrationBlocks()) {
-    blocks.push_back(block);
-    keys.push_back(block == time_offset_ ? BlockKey::TimeOffset() : BlockKey::Extrinsics());
+  // The pose, the landmark, then CalibrationBlocks() in its order (time offset, extrinsics).
+  constexpr std::size_t kMostBlocks = 4;
+  std::vector<double*> blocks;
+  std::vector<BlockKey> keys;
+  blocks.reserve(kMostBlocks);
+  keys.reserve(kMostBlocks);
+  blocks.push_back(s.pose);
+  blocks.push_back(it->second.p_w);
+  keys.push_back(BlockKey::Pose(state_id));
+  keys.push_back(BlockKey::Landmark(landmark_id));
+  if (estimates_time_offset()) {
+    blocks.push_back(time_offset_);
+    keys.push_back(BlockKey::TimeOffset());
+  }
+  if (estimates_extrinsics()) {
+    blocks.push_back(extrinsic_);
+    keys.push_back(BlockKey::Extrinsics());
   }
   const ceres::ResidualBlockId residual = problem_->AddResidualBlock(
       WithFirstEstimates(Wrap(StereoFactorOf(state_id, landmark_id, z_px)), std::move(keys)), loss_.get(), blocks);

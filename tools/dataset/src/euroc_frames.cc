@@ -137,8 +137,9 @@ bool FeatureCsvStream::Next(std::vector<FeatureObservation>* group) {
   do {
     r.rows.push_back(*r.pending);
   } while (r.ReadRow() && r.pending->first.t_ns == t_ns);
-  std::stable_sort(r.rows.begin(), r.rows.end(),
-                   [](const auto& a, const auto& b) { return SortKey(a.first) < SortKey(b.first); });
+  // The simulator writes each frame's rows in this order already: then there is nothing to sort.
+  const auto by_key = [](const auto& a, const auto& b) { return SortKey(a.first) < SortKey(b.first); };
+  if (!std::is_sorted(r.rows.begin(), r.rows.end(), by_key)) std::stable_sort(r.rows.begin(), r.rows.end(), by_key);
   for (std::size_t i = 0; i < r.rows.size(); ++i) {
     if (i > 0 && SortKey(r.rows[i].first) == SortKey(r.rows[i - 1].first)) {
       throw LineError(r.csv.path(), r.rows[i].second,
