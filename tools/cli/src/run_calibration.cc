@@ -80,7 +80,9 @@ void RecordCalibration(const EurocDataset& dataset, Estimator& estimator, const 
   calibration->extrinsics_estimated = window.estimates_extrinsics();
   // The body's turn from the given rig to the estimated one, and the left camera's move.
   const Eigen::Isometry3d estimated = window.estimated_stereo().T_b_cl;
-  calibration->extrinsics_rotation_deg = so3::Log(estimated.linear() * given.linear().transpose()) * (180.0 / M_PI);
+  const Eigen::Matrix3d turn = estimated.linear() == given.linear() ? Eigen::Matrix3d::Identity()
+                                                                      : Eigen::Matrix3d(estimated.linear() * given.linear().transpose());
+  calibration->extrinsics_rotation_deg = so3::Log(turn) * (180.0 / M_PI);
   calibration->extrinsics_translation_m = estimated.translation() - given.translation();
   if (searches.rig_rotation) RecordRigRotationSearch(*searches.rig_rotation, calibration);
   if (const std::optional<Eigen::Matrix<double, 6, 6>> covariance = estimator.ExtrinsicCovariance()) {
