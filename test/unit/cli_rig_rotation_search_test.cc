@@ -41,6 +41,9 @@ RunResult RunWith(const std::string& dataset, bool search, std::string* output, 
   request.config.estimator.policy.policy = "swf";
   request.config.estimator.model.extrinsics_rotation_search = search;
   request.config.estimator.model.estimate_extrinsics = extrinsics;
+  // The search's own restart (with the extrinsics probe, cli_run_extrinsics_test, the probe decides
+  // after the turn instead).
+  request.config.estimator.model.extrinsics_probe_s = 0;
   // The simulator's IMU noise is the datasheet's: the matching model (cli_run_time_offset_test).
   request.config.estimator.model.imu_noise_scale = 1.0;
   return RunDataset(request);

@@ -14,6 +14,7 @@
 #include <glog/logging.h>
 
 #include "run_calibration.h"
+#include "run_probe.h"
 #include "run_control.h"
 #include "run_output.h"
 #include "vio/estimator/estimator.h"
@@ -215,11 +216,12 @@ void AddEarlierEstimates(Estimator& estimator, Timestamp first_covered_ns, Times
 // Bad data mid-run ends the loop with a status; what was estimated is kept.
 // `observations` (null: none written) receives every frame the estimator is given.
 // A stop request ends it before the next frame, or (a solve cut short) drops the frame in hand.
+// `probe` (null: none in this pass) is updated after each estimate.
 // Returns true when a search at initialization (time offset, rig rotation) found the rig beyond its
-// prior (the pass ends there).
+// prior or the probe decided (the pass ends there).
 bool EstimateFrames(const RunRequest& request, const EurocDataset& dataset, FrameSource& source,
                     Estimator& estimator, RunOutput& output, ObservationsCsvWriter* observations,
-                    ProgressBar& progress, RunResult* result) {
+                    ExtrinsicsProbe* probe, ProgressBar& progress, RunResult* result) {
   const bool init_from_gt = request.config.estimator.init.init == "groundtruth";
   ImuCursor imu{dataset, request.config.estimator.model.max_imu_gap_s};
   Timestamp first_covered_ns = -1;  // the first frame the IMU covers
@@ -274,6 +276,7 @@ bool EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
         break;
       }
       output.AddFrame(estimate);
+      if (probe != nullptr && probe->Update(t_ns, estimator)) return true;
       if (request.output_covariance) {
         if (const std::optional<StateCovariance> covariance = estimator.NewestCovariance()) {
           output.AddCovariance(*covariance);
@@ -445,11 +448,16 @@ void ValidateRequest(const RunRequest& request) {
   }
 }
 
+// How a pass ended: at the data's end (or a stop), at a search's request to start again, or at the
+// extrinsics probe's decision (nothing is written at either).
+enum class PassEnd { kFinished, kSearch, kProbe };
+
 // One pass over the dataset. `searches`: the searches' results of an earlier pass that ended at them
-// (this one runs with the rig they found; `earlier_pass_s` its processing time, counted in this
-// one's), else empty and filled when this pass's searches ask to start again (nothing is written then).
+// (this one runs with the rig they found), else empty and filled when this pass's searches ask to
+// start again. `probe` (null: none): undecided, it runs in this pass; decided, the rig it found is
+// this pass's when it applied it. `earlier_pass_s`: the earlier passes' processing time, counted in this one's.
 RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset, InitSearches* searches,
-                  double earlier_pass_s) {
+                  ExtrinsicsProbe* probe, double earlier_pass_s, PassEnd* end) {
   RunRequest request = requested;
   request.config.frontend.frontend = ResolveFrontend(requested.config.frontend.frontend, dataset);
   const frontend::StereoRectifier rectifier(dataset.cameras[0], dataset.cameras[1]);
@@ -459,7 +467,10 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset, Init
   if (request.config.estimator.init.init == "groundtruth" && dataset.groundtruth.empty()) {
     throw std::runtime_error(request.dataset_dir + ": --init=groundtruth but the dataset has no ground truth");
   }
-  Estimator estimator(request.config.estimator, dataset.imu_calibration, TurnedRig(rectifier.rectified(), *searches));
+  const bool probing = probe != nullptr && !probe->decided();
+  const RectifiedStereo rig =
+      probe != nullptr && probe->applied() ? probe->rig() : TurnedRig(rectifier.rectified(), *searches);
+  Estimator estimator(request.config.estimator, dataset.imu_calibration, rig);
   const bool refine = request.trajectory == "smoothed" && request.config.estimator.policy.policy != "batch";
   if (refine) estimator.KeepMeasurements();
   RunOutput output(request.output_dir);
@@ -478,11 +489,19 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset, Init
   const auto start = std::chrono::steady_clock::now();
   std::optional<ObservationsCsvWriter> observations;
   if (request.output_observations) observations.emplace(request.output_dir + "/observations.csv");
-  if (EstimateFrames(request, dataset, *source, estimator, output, observations ? &*observations : nullptr, progress,
-                     &result)) {
+  *end = PassEnd::kFinished;
+  if (EstimateFrames(request, dataset, *source, estimator, output, observations ? &*observations : nullptr,
+                     probing ? probe : nullptr, progress, &result)) {
+    *end = estimator.restart_requested() ? PassEnd::kSearch : PassEnd::kProbe;
+  } else if (probing && result.status != "interrupted") {  // the data ended (or the run stopped) first
+    probe->Finish(estimator);
+    *end = PassEnd::kProbe;
+  }
+  if (*end != PassEnd::kFinished) {
     progress.Stop();
-    *searches = InitSearches{estimator.time_offset_search(), estimator.rig_rotation_search()};
-    result.processing_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (*end == PassEnd::kSearch) *searches = InitSearches{estimator.time_offset_search(), estimator.rig_rotation_search()};
+    result.processing_s =
+        earlier_pass_s + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
   }
   if (observations) observations->Close();
@@ -497,8 +516,9 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset, Init
   const InitSearches found = searches->restart()
                                  ? *searches
                                  : InitSearches{estimator.time_offset_search(), estimator.rig_rotation_search()};
-  RecordCalibration(dataset, estimator, found, &result.calibration);
-  if (estimator.window().estimates_extrinsics() || searches->restart()) {
+  RecordCalibration(dataset, estimator, found, rectifier.rectified().T_b_cl, &result.calibration);
+  if (probe != nullptr) result.calibration.extrinsics_probe = probe->report();
+  if (estimator.window().estimates_extrinsics() || searches->restart() || (probe != nullptr && probe->applied())) {
     WriteCalibration(dataset, estimator.window(), rectifier.rectified().T_b_cl, request.output_dir + "/calibration");
   }
   if (refine && result.status == "ok") {
@@ -529,39 +549,35 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset, Init
 
 }  // namespace
 
-// A search at initialization found the camera-IMU time offset or the rig's rotation beyond its prior:
-// the run starts again from the first frame with the rig found (docs/calibration.md).
+// A search at initialization found the camera-IMU time offset or the rig's rotation beyond its prior,
+// or the extrinsics probe decided: the run starts again from the first frame (docs/calibration.md).
+// At most three passes: the searches' results and the probe's decision each end one once.
 RunResult RunDataset(const RunRequest& requested) {
   ValidateRunConfig(requested.config);
   ValidateRequest(requested);
   WarnAboutQuestionableSettings(requested.config);
   const EurocDataset dataset = ReadRunDataset(requested);
+  std::optional<ExtrinsicsProbe> probe;
+  if (ProbesExtrinsics(requested.config)) probe.emplace(requested.config.estimator.model);
   InitSearches searches;
-  const RunResult first = RunPass(requested, dataset, &searches, 0.0);
-  if (!searches.restart()) return first;
-  RunRequest again = requested;
-  ModelOptions& model = again.config.estimator.model;
-  model.time_offset_search_ms = 0;
-  model.extrinsics_rotation_search = false;
-  if (searches.time_offset && searches.time_offset->restart) {
-    const Estimator::TimeOffsetSearchReport& search = *searches.time_offset;
-    model.time_offset_prior_mean_ms = 1e3 * search.offset_s;
-    LOG(WARNING) << "the camera-IMU time offset is " << 1e3 * search.offset_s << " +- " << 1e3 * search.sigma_s
-                 << " ms, beyond its prior (time_offset_prior_mean_ms " << requested.config.estimator.model.time_offset_prior_mean_ms
-                 << " +- " << requested.config.estimator.model.time_offset_prior_sigma_ms
-                 << " ms): starting again from the first frame with the prior's mean there";
+  RunRequest request = requested;  // with the searches' results once they asked to start again
+  double elapsed_s = 0;
+  for (;;) {
+    RunRequest pass = request;
+    if (probe && !probe->decided()) {
+      // The probe measures the rig with the sliding window whatever the run's policy: MSCKF's estimate
+      // of the translation was the worse (docs/calibration.md).
+      pass.config.estimator.model.estimate_extrinsics = true;
+      pass.config.estimator.policy.policy = "swf";
+    }
+    PassEnd end = PassEnd::kFinished;
+    RunResult result = RunPass(pass, dataset, &searches, probe ? &*probe : nullptr, elapsed_s, &end);
+    if (end == PassEnd::kFinished) return result;
+    elapsed_s = result.processing_s;
+    if (end == PassEnd::kSearch) request = AfterSearches(request, searches, !probe.has_value());
+    // The probe's rig holds any turn the rig rotation search found before it.
+    if (end == PassEnd::kProbe && probe->applied()) request.config.estimator.model.extrinsics_rotation_search = false;
   }
-  if (searches.rig_rotation && searches.rig_rotation->restart) {
-    const Estimator::RigRotationSearchReport& search = *searches.rig_rotation;
-    // The search is within about a degree (the gyro's own axes against the accelerometer's): the
-    // online correction takes it from there.
-    model.estimate_extrinsics = true;
-    LOG(WARNING) << "the cameras' rotation in the body is off by " << search.rotation_vector.norm() * 180.0 / M_PI
-                 << " +- " << search.sigma_rad * 180.0 / M_PI << " deg from sensor.yaml's (beyond "
-                 << "2 extrinsics_prior_sigma_deg): starting again from the first frame with the cameras turned by it "
-                    "and the extrinsics estimated online";
-  }
-  return RunPass(again, dataset, &searches, first.processing_s);
 }
 
 }  // namespace vio::tools

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include <Eigen/Eigenvalues>
+#include <glog/logging.h>
 
 #include "vio/estimator/so3.h"
 
@@ -22,6 +23,36 @@ RectifiedStereo TurnedRig(const RectifiedStereo& rig, const InitSearches& search
   return turned;
 }
 
+RunRequest AfterSearches(const RunRequest& request, const InitSearches& searches, bool estimate_turned) {
+  RunRequest again = request;
+  ModelOptions& model = again.config.estimator.model;
+  model.time_offset_search_ms = 0;
+  model.extrinsics_rotation_search = false;
+  if (searches.time_offset && searches.time_offset->restart) {
+    const Estimator::TimeOffsetSearchReport& search = *searches.time_offset;
+    model.time_offset_prior_mean_ms = 1e3 * search.offset_s;
+    LOG(WARNING) << "the camera-IMU time offset is " << 1e3 * search.offset_s << " +- " << 1e3 * search.sigma_s
+                 << " ms, beyond its prior (time_offset_prior_mean_ms " << request.config.estimator.model.time_offset_prior_mean_ms
+                 << " +- " << request.config.estimator.model.time_offset_prior_sigma_ms
+                 << " ms): starting again from the first frame with the prior's mean there";
+  }
+  if (searches.rig_rotation && searches.rig_rotation->restart) {
+    const Estimator::RigRotationSearchReport& search = *searches.rig_rotation;
+    // The search is within about a degree (the gyro's own axes against the accelerometer's): the
+    // online correction (or the probe) takes it from there.
+    if (estimate_turned) model.estimate_extrinsics = true;
+    LOG(WARNING) << "the cameras' rotation in the body is off by " << search.rotation_vector.norm() * 180.0 / M_PI
+                 << " +- " << search.sigma_rad * 180.0 / M_PI << " deg from sensor.yaml's (beyond "
+                 << "2 extrinsics_prior_sigma_deg): starting again from the first frame with the cameras turned by it"
+                 << (estimate_turned ? " and the extrinsics estimated online" : "");
+  }
+  return again;
+}
+
+double LargestSigma(const Eigen::Matrix3d& covariance) {
+  return std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues().maxCoeff());
+}
+
 namespace {
 
 void RecordRigRotationSearch(const Estimator::RigRotationSearchReport& search, CalibrationReport* calibration) {
@@ -34,7 +65,7 @@ void RecordRigRotationSearch(const Estimator::RigRotationSearchReport& search, C
 }  // namespace
 
 void RecordCalibration(const EurocDataset& dataset, Estimator& estimator, const InitSearches& searches,
-                       CalibrationReport* calibration) {
+                       const Eigen::Isometry3d& given, CalibrationReport* calibration) {
   const std::optional<Estimator::TimeOffsetSearchReport>& search = searches.time_offset;
   calibration->time_offset_estimated = estimator.window().estimates_time_offset();
   calibration->time_offset_calibration_ms = 1e-6 * static_cast<double>(dataset.camera_time_offset_ns);
@@ -47,21 +78,18 @@ void RecordCalibration(const EurocDataset& dataset, Estimator& estimator, const 
   }
   const Window& window = estimator.window();
   calibration->extrinsics_estimated = window.estimates_extrinsics();
-  const Eigen::Matrix<double, 6, 1> c = window.extrinsic_correction();
-  // In the body: the rig turned by Exp(R_b_cl dtheta) (R_b_cl Exp(dtheta) = Exp(R_b_cl dtheta) R_b_cl).
-  // The search's turn Q first (the window's rig is sensor.yaml's turned by it): Exp(R_b_cl dtheta) Q.
-  const Eigen::Matrix3d turn = so3::Exp(window.stereo().T_b_cl.linear() * c.head<3>()) * searches.RigTurn();
+  // The body's turn from the given rig to the estimated one, and the left camera's move.
+  const Eigen::Isometry3d estimated = window.estimated_stereo().T_b_cl;
+  const Eigen::Matrix3d turn = estimated.linear() == given.linear() ? Eigen::Matrix3d::Identity()
+                                                                      : Eigen::Matrix3d(estimated.linear() * given.linear().transpose());
   calibration->extrinsics_rotation_deg = so3::Log(turn) * (180.0 / M_PI);
+  calibration->extrinsics_translation_m = estimated.translation() - given.translation();
   if (searches.rig_rotation) RecordRigRotationSearch(*searches.rig_rotation, calibration);
-  calibration->extrinsics_translation_m = c.tail<3>();
   if (const std::optional<Eigen::Matrix<double, 6, 6>> covariance = estimator.ExtrinsicCovariance()) {
-    const auto largest_sigma = [](const Eigen::Matrix3d& block) {
-      return std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(block).eigenvalues().maxCoeff());
-    };
     const Eigen::Matrix3d R_b_cl = window.stereo().T_b_cl.linear();
     calibration->extrinsics_rotation_sigma_deg =
-        largest_sigma(R_b_cl * covariance->topLeftCorner<3, 3>() * R_b_cl.transpose()) * (180.0 / M_PI);
-    calibration->extrinsics_translation_sigma_m = largest_sigma(covariance->bottomRightCorner<3, 3>());
+        LargestSigma(R_b_cl * covariance->topLeftCorner<3, 3>() * R_b_cl.transpose()) * (180.0 / M_PI);
+    calibration->extrinsics_translation_sigma_m = LargestSigma(covariance->bottomRightCorner<3, 3>());
   }
 }
 

@@ -26,11 +26,19 @@ struct InitSearches {
 /// (the run's second pass), else `rig` unchanged.
 RectifiedStereo TurnedRig(const RectifiedStereo& rig, const InitSearches& searches);
 
+/// The request of the pass after a search asked to start again: both searches off, the time offset
+/// prior's mean at the found offset; the rig's turn is TurnedRig's, and `estimate_turned` estimates the
+/// extrinsics online from there (without the extrinsics probe, which decides that otherwise).
+RunRequest AfterSearches(const RunRequest& request, const InitSearches& searches, bool estimate_turned);
+
+/// The largest standard deviation over directions of a 3x3 covariance.
+double LargestSigma(const Eigen::Matrix3d& covariance);
+
 /// The calibration the run ends with: the time offset (the calibration file's plus the estimate)
-/// and the extrinsics' change from sensor.yaml's (the searches' turn and the window's correction),
-/// with their sigmas.
+/// and the extrinsics' change from `given` (sensor.yaml's rectified left camera in the body) to the
+/// window's estimated rig (the searches' turn, the probe's correction and the window's), with their sigmas.
 void RecordCalibration(const EurocDataset& dataset, Estimator& estimator, const InitSearches& searches,
-                       CalibrationReport* calibration);
+                       const Eigen::Isometry3d& given, CalibrationReport* calibration);
 
 /// Writes `dir`/mav0/{cam0,cam1,imu0}/sensor.yaml: the dataset's calibration with both cameras'
 /// T_BS moved rigidly from `given` (sensor.yaml's rectified left camera in the body) to the window's

@@ -161,6 +161,17 @@ void WriteExtrinsics(const CalibrationReport& c, std::ostream& out) {
         << ", \"excited\": " << (c.rig_rotation_search_excited ? "true" : "false")
         << ", \"restarted\": " << (c.rig_rotation_search_restarted ? "true" : "false") << "}";
   }
+  if (c.extrinsics_probe) {
+    const CalibrationReport::ExtrinsicsProbe& p = *c.extrinsics_probe;
+    out << ", \"extrinsics_probe\": {\"duration_s\": " << JsonNumber(p.duration_s)
+        << ", \"rotation_deg\": " << JsonNumber(p.rotation_deg.norm())
+        << ", \"translation_m\": " << JsonNumber(p.translation_m.norm())
+        << ", \"rotation_vector_deg\": " << vector(p.rotation_deg) << ", \"translation_vector_m\": " << vector(p.translation_m);
+    if (p.rotation_sigma_deg) out << ", \"rotation_sigma_deg\": " << JsonNumber(*p.rotation_sigma_deg);
+    if (p.translation_sigma_m) out << ", \"translation_sigma_m\": " << JsonNumber(*p.translation_sigma_m);
+    if (p.chi2) out << ", \"chi2\": " << JsonNumber(*p.chi2);
+    out << ", \"applied\": " << (p.applied ? "true" : "false") << "}";
+  }
 }
 
 }  // namespace

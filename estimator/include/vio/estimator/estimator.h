@@ -89,6 +89,8 @@ class Estimator {
     bool restart = false;
   };
   const std::optional<RigRotationSearchReport>& rig_rotation_search() const { return rig_rotation_search_; }
+  /// Whether a search at initialization (time offset, rig rotation) is still running.
+  bool searching() const { return offset_search_.has_value() || rig_search_.has_value(); }
   /// Whether a search asks to start the run again (time offset or rig rotation).
   bool restart_requested() const {
     return (time_offset_search_ && time_offset_search_->restart) || (rig_rotation_search_ && rig_rotation_search_->restart);

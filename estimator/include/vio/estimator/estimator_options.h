@@ -251,6 +251,9 @@ struct ModelOptions {
   double extrinsics_prior_sigma_m = 0.02;   ///< prior standard deviation of its translation, per axis [m]
   double time_offset_search_ms = 100.0;  ///< range of the coarse search at initialization, either side [ms]; 0: none
   bool extrinsics_rotation_search = true;  ///< the rig's rotation found from gyro against camera at initialization
+  double extrinsics_probe_s = 30.0;      ///< longest probe of the extrinsics at the start [s]; 0: no probe
+  double extrinsics_probe_min_deg = 0.5;  ///< smallest rotation correction the probe applies [deg]
+  double extrinsics_probe_min_m = 0.01;   ///< smallest translation correction the probe applies [m]
 
   template <class V>
   void Visit(V& v) {
@@ -297,6 +300,21 @@ struct ModelOptions {
       "in the first seconds of rotation the rig's rotation is fitted to the gyro's against the camera's (hand-eye); "
       "a rotation beyond 2 extrinsics_prior_sigma_deg (and 3 of its own sigmas) starts the run again with sensor.yaml's "
       "cameras turned by it (docs/calibration.md)");
+    v("extrinsics_probe_s", extrinsics_probe_s,
+      "without estimate_extrinsics: the run first estimates the extrinsics from the first frame until their sigmas "
+      "are below half of extrinsics_probe_min_deg / _m or this much frame time after initialization has passed; a "
+      "correction significant against its covariance (chi-square, 6 dof, 0.1 %) and at least extrinsics_probe_min_deg "
+      "or extrinsics_probe_min_m starts the run again from the first frame with the rig corrected, else the run is "
+      "the one without the probe (docs/calibration.md); 0: no probe [s]",
+      Between(0, 1000));
+    v("extrinsics_probe_min_deg", extrinsics_probe_min_deg,
+      "the extrinsics probe applies a correction only when its rotation is at least this or its translation at least "
+      "extrinsics_probe_min_m [deg]",
+      Positive(90));
+    v("extrinsics_probe_min_m", extrinsics_probe_min_m,
+      "the extrinsics probe applies a correction only when its translation is at least this or its rotation at least "
+      "extrinsics_probe_min_deg [m]",
+      Positive(10));
   }
 };
 

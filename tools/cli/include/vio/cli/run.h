@@ -97,6 +97,16 @@ struct CalibrationReport {
   double rig_rotation_search_sigma_deg = 0;
   bool rig_rotation_search_excited = false;
   bool rig_rotation_search_restarted = false;
+  /// The extrinsics probe (extrinsics_probe_s), when it decided (docs/calibration.md).
+  struct ExtrinsicsProbe {
+    double duration_s = 0;  ///< frame time from the first estimate to the decision [s]
+    Eigen::Vector3d rotation_deg = Eigen::Vector3d::Zero();  ///< its rotation vector, body frame [deg]
+    Eigen::Vector3d translation_m = Eigen::Vector3d::Zero();  ///< the left camera's move, body frame [m]
+    std::optional<double> rotation_sigma_deg, translation_sigma_m;  ///< largest over directions
+    std::optional<double> chi2;  ///< the correction's squared Mahalanobis norm (6 dof)
+    bool applied = false;        ///< significant and large enough: the run started again with it
+  };
+  std::optional<ExtrinsicsProbe> extrinsics_probe;
 };
 
 struct RunResult {
