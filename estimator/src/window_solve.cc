@@ -211,8 +211,6 @@ SolveReport Window::Solve(const SolverOptions& options) {
   ceres::Solver::Options solver;
   solver.max_num_iterations = options.max_iterations;
   solver.function_tolerance = options.function_tolerance;
-  solver.parameter_tolerance = options.parameter_tolerance;
-  solver.gradient_tolerance = options.gradient_tolerance;
   return LevenbergMarquardt(solver, options);
 }
 

@@ -43,8 +43,6 @@ ceres::Solver::Options LinearSolverOptions(const SolverOptions& options,
   ceres::Solver::Options solver;
   solver.max_num_iterations = options.max_iterations;
   solver.function_tolerance = options.function_tolerance;
-  solver.parameter_tolerance = options.parameter_tolerance;
-  solver.gradient_tolerance = options.gradient_tolerance;
   if (options.max_solver_time_s > 0) solver.max_solver_time_in_seconds = options.max_solver_time_s;
   solver.num_threads = options.num_threads;
   solver.logging_type = ceres::SILENT;

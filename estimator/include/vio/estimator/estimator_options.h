@@ -199,8 +199,7 @@ struct SolverOptions {
   /// lm: Ceres' Levenberg-Marquardt (trust region, steps may be rejected).
   std::string step = "gn";
   int max_iterations = 10;        ///< most steps of a to-convergence solve (a safety net) [count]
-  double parameter_tolerance = 1e-8;  ///< converged when |dx| <= this * (|x| + this) (gn and lm) []
-  double gradient_tolerance = 1e-10;  ///< lm: converged when the largest gradient component is <= this []
+  double parameter_tolerance = 1e-8;  ///< gn: converged when |dx| <= this * (|x| + this) []
   double max_solver_time_s = 0.0;   ///< wall-time bound per solve [s]; 0 = none (a run that hits one is not reproducible)
   double function_tolerance = 1e-3;  ///< relative cost change that counts as converged []
   int num_threads = 1;            ///< Ceres threads [count]
@@ -217,11 +216,7 @@ struct SolverOptions {
       "parameter_tolerance) [count]",
       AtLeast(1));
     v("parameter_tolerance", parameter_tolerance,
-      "converged when the step |dx| <= this * (|x| + this) (gn; lm: Ceres' parameter_tolerance) []", Positive(1));
-    v("gradient_tolerance", gradient_tolerance,
-      "lm: converged when the largest component of the gradient (on the manifold) is <= this (Ceres' "
-      "gradient_tolerance) []",
-      Positive(1));
+      "gn: converged when the step |dx| <= this * (|x| + this) []", Positive(1));
     v("linear_solver", linear_solver,
       "dense or sparse Cholesky of the Schur-reduced system (sparse: large windows), sparse_full (sparse Cholesky "
       "of the whole system, states eliminated before landmarks: whole sequences, batch's final solve) or iterative "
