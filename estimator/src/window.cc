@@ -104,6 +104,9 @@ State& Window::AddState(StateId id, Timestamp t_ns) {
   s.t_ns = t_ns;
   problem_->AddParameterBlock(s.pose, kPoseSize, pose_manifold_.get());
   problem_->AddParameterBlock(s.speed_bias, kSpeedBiasSize);
+  variable_states_.insert(id);
+  block_keys_[s.pose] = BlockKey::Pose(id);
+  block_keys_[s.speed_bias] = BlockKey::SpeedBias(id);
   return s;
 }
 
@@ -156,6 +159,8 @@ Landmark& Window::AddLandmark(LandmarkId id, const Eigen::Vector3d& p_w) {
   l.id = id;
   Eigen::Map<Eigen::Vector3d>(l.p_w) = p_w;
   problem_->AddParameterBlock(l.p_w, kLandmarkSize);
+  variable_landmarks_.insert(id);
+  block_keys_[l.p_w] = BlockKey::Landmark(id);
   return l;
 }
 
@@ -229,6 +234,11 @@ void Window::SetStateConstant(StateId id, bool constant) {
       problem_->SetParameterBlockVariable(block);
     }
   }
+  if (constant) {
+    variable_states_.erase(id);
+  } else {
+    variable_states_.insert(id);
+  }
 }
 
 void Window::SetLandmarkConstant(LandmarkId id, bool constant) {
@@ -236,8 +246,10 @@ void Window::SetLandmarkConstant(LandmarkId id, bool constant) {
   CHECK(it != landmarks_.end()) << "no landmark " << id.value << " in the window";
   if (constant) {
     problem_->SetParameterBlockConstant(it->second.p_w);
+    variable_landmarks_.erase(id);
   } else {
     problem_->SetParameterBlockVariable(it->second.p_w);
+    variable_landmarks_.insert(id);
   }
 }
 
@@ -295,7 +307,7 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   }
   for (LandmarkId id : landmark_ids) {
     removals_.leaving_landmarks.emplace_back(id, landmarks_.at(id).position());
-    landmarks_.erase(id);
+    RemoveLandmarkBookkeeping(id);
   }
   removals_.marginalized_states.insert(removals_.marginalized_states.end(), state_ids.begin(), state_ids.end());
   removals_.marginalized_landmarks.insert(removals_.marginalized_landmarks.end(), landmark_ids.begin(),
@@ -389,8 +401,18 @@ void Window::DropOutlierObservations(const std::vector<ObservationKey>& observat
 }
 
 void Window::RemoveStateBookkeeping(StateId id) {
+  const State& s = state(id);
+  block_keys_.erase(s.pose);
+  block_keys_.erase(s.speed_bias);
+  variable_states_.erase(id);
   states_.erase(id);
   camera_timing_.erase(id);
+}
+
+void Window::RemoveLandmarkBookkeeping(LandmarkId id) {
+  block_keys_.erase(landmark(id).p_w);
+  variable_landmarks_.erase(id);
+  landmarks_.erase(id);
 }
 
 void Window::DropObservation(StateId state_id, LandmarkId landmark_id) {
@@ -407,7 +429,7 @@ void Window::DropLandmark(LandmarkId landmark_id) {
   ForgetResidualsOf(LeavingOf({}, {landmark_id}));
   removals_.leaving_landmarks.emplace_back(landmark_id, it->second.position());
   problem_->RemoveParameterBlock(it->second.p_w);
-  landmarks_.erase(landmark_id);
+  RemoveLandmarkBookkeeping(landmark_id);
   removals_.dropped_landmarks.push_back(landmark_id);
 }
 

@@ -20,6 +20,7 @@ void Window::EstimateTimeOffset(double mean_s, double sigma_s) {
   CHECK(sigma_s > 0 && std::isfinite(mean_s)) << "time offset prior: sigma " << sigma_s << ", mean " << mean_s;
   time_offset_[0] = mean_s;
   problem_->AddParameterBlock(time_offset_, 1);
+  block_keys_[time_offset_] = BlockKey::TimeOffset();
   // N(mean, sigma^2) as a linear factor r = (t_d - mean) / sigma, kept with the priors.
   std::vector<marginalization::MarginalizationPrior::Block> block = {{nullptr, {mean_s}}};
   auto factor = marginalization::MarginalizationPrior::Create(
@@ -34,6 +35,7 @@ void Window::EstimateExtrinsics(double sigma_rad, double sigma_m) {
   CHECK(observations_.empty()) << "EstimateExtrinsics after observations were added";
   CHECK(sigma_rad > 0 && sigma_m > 0) << "extrinsics prior: sigmas " << sigma_rad << " rad, " << sigma_m << " m";
   problem_->AddParameterBlock(extrinsic_, 6);
+  block_keys_[extrinsic_] = BlockKey::Extrinsics();
   // N(0, diag(sigma_rad^2, sigma_m^2)) as a linear factor r = diag(1/sigma) c, kept with the priors.
   std::vector<marginalization::MarginalizationPrior::Block> block = {{nullptr, std::vector<double>(6, 0.0)}};
   Eigen::Matrix<double, 6, 1> information;

@@ -22,17 +22,9 @@ void Window::HoldFirstEstimates(const std::vector<double*>& blocks) {
 }
 
 BlockKey Window::KeyOf(const double* block) const {
-  for (const auto& [id, s] : states_) {
-    if (block == s.pose) return BlockKey::Pose(id);
-    if (block == s.speed_bias) return BlockKey::SpeedBias(id);
-  }
-  for (const auto& [id, landmark] : landmarks_) {
-    if (block == landmark.p_w) return BlockKey::Landmark(id);
-  }
-  if (block == time_offset_) return BlockKey::TimeOffset();
-  if (block == extrinsic_) return BlockKey::Extrinsics();
-  LOG(FATAL) << "a parameter block that is neither a state nor a landmark of the window";
-  return {};
+  const auto it = block_keys_.find(block);
+  CHECK(it != block_keys_.end()) << "a parameter block that is neither a state nor a landmark of the window";
+  return it->second;
 }
 
 }  // namespace vio

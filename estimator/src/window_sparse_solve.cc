@@ -4,12 +4,15 @@
 // blocks of one elimination group by address; in the copy every block lives
 // in one buffer filled in id order, so that order is the id order and the
 // solve depends only on the values (batch's solves; bundle adjustment).
+#include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <memory>
 #include <map>
 #include <set>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
@@ -58,6 +61,26 @@ ceres::Solver::Options LinearSolverOptions(const SolverOptions& options,
   return solver;
 }
 
+// A block's place in a copy: states by id (pose, then speed/bias), landmarks by id, then the
+// calibration blocks (time offset, extrinsics).
+using CopyRank = std::tuple<int, std::int64_t, int>;
+
+CopyRank RankOf(const BlockKey& key) {
+  switch (key.kind) {
+    case BlockKey::Kind::kPose:
+      return {0, key.id, 0};
+    case BlockKey::Kind::kSpeedBias:
+      return {0, key.id, 1};
+    case BlockKey::Kind::kLandmark:
+      return {1, key.id, 0};
+    case BlockKey::Kind::kTimeOffset:
+      return {2, 0, 0};
+    case BlockKey::Kind::kExtrinsics:
+      return {3, 0, 0};
+  }
+  return {4, 0, 0};
+}
+
 }  // namespace
 
 // The window's blocks a set of residuals touches, copied into one buffer in
@@ -86,42 +109,35 @@ Window::Leaving Window::SolvedOf(const VariableIds& variable) {
 }
 
 Window::VariableIds Window::VariableIdsOf() const {
-  const auto variable = [this](const double* block) { return !problem_->IsParameterBlockConstant(block); };
-  VariableIds ids;
-  for (const auto& [id, s] : states_) {
-    if (variable(s.pose) || variable(s.speed_bias)) ids.states.push_back(id);
-  }
-  for (const auto& [id, landmark] : landmarks_) {
-    if (variable(landmark.p_w)) ids.landmarks.push_back(id);
-  }
-  return ids;
+  return {{variable_states_.begin(), variable_states_.end()}, {variable_landmarks_.begin(), variable_landmarks_.end()}};
 }
 
 // Every block the residuals and `extra` touch, states (pose, speed/bias) then landmarks, by id.
 Window::IdOrderedCopy Window::CopyOf(const std::vector<ceres::ResidualBlockId>& residuals,
                                      const LandmarkFactors& extra) const {
-  std::unordered_map<const double*, int> touched;
+  std::unordered_map<const double*, CopyRank> touched;
+  const auto touch = [&](const double* block) {
+    const auto key = block_keys_.find(block);
+    CHECK(key != block_keys_.end()) << "a residual touches a block that is no state, landmark or calibration";
+    touched.emplace(block, RankOf(key->second));
+  };
   for (ceres::ResidualBlockId residual : residuals) {
     std::vector<double*> blocks;
     problem_->GetParameterBlocksForResidualBlock(residual, &blocks);
-    for (const double* block : blocks) touched.emplace(block, 0);
+    for (const double* block : blocks) touch(block);
   }
-  for (const auto& [block, factor] : extra) touched.emplace(block, 0);
+  for (const auto& [block, factor] : extra) touch(block);
+  std::vector<std::pair<CopyRank, const double*>> order;
+  order.reserve(touched.size());
+  for (const auto& [block, rank] : touched) order.emplace_back(rank, block);
+  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   IdOrderedCopy copy;
   std::vector<size_t> offsets;
-  const auto take = [&](const double* block) {
-    if (!touched.count(block)) return;
+  for (const auto& [rank, block] : order) {
     copy.blocks.push_back(block);
     offsets.push_back(copy.values.size());
     copy.values.insert(copy.values.end(), block, block + problem_->ParameterBlockSize(block));
-  };
-  for (const auto& [id, s] : states_) {
-    take(s.pose);
-    take(s.speed_bias);
   }
-  for (const auto& [id, landmark] : landmarks_) take(landmark.p_w);
-  for (const double* block : CalibrationBlocks()) take(block);
-  CHECK_EQ(copy.blocks.size(), touched.size()) << "a residual touches a block that is no state, landmark or calibration";
   for (size_t k = 0; k < copy.blocks.size(); ++k) copy.copy_of[copy.blocks[k]] = copy.values.data() + offsets[k];
   return copy;
 }
@@ -149,9 +165,14 @@ std::vector<ceres::ResidualBlockId> Window::RecentResidualOrderOf(const Leaving&
   for (const Prior& prior : priors_) {
     if (Touches(prior, solved)) order.push_back(prior.residual);
   }
-  for (const auto& [to, edge] : imu_edges_) {
-    if (Touches(to, edge, solved)) order.push_back(edge.residual);
+  // The IMU factors into and out of the solved states, by their later state.
+  std::set<StateId> edges;
+  for (StateId id : solved.states) {
+    if (imu_edges_.count(id)) edges.insert(id);
+    const auto out = imu_edges_.upper_bound(id);
+    if (out != imu_edges_.end() && out->second.from == id) edges.insert(out->first);
   }
+  for (StateId to : edges) order.push_back(imu_edges_.at(to).residual);
   for (StateId id : solved.states) {
     for (auto it = observations_.lower_bound({id, LandmarkId(std::numeric_limits<std::int64_t>::min())});
          it != observations_.end() && it->first.first == id; ++it) {
@@ -173,24 +194,32 @@ std::vector<ceres::ResidualBlockId> Window::RecentResidualOrderOf(const Leaving&
 // dense system. Landmarks first would leave a nearly dense system over every
 // pose; states first (the IMU chain) a dense block of every state against
 // every landmark.
-std::unordered_map<const double*, int> Window::EliminationGroups(const std::string& linear_solver) const {
+std::unordered_map<const double*, int> Window::EliminationGroups(const std::string& linear_solver,
+                                                                 const std::vector<const double*>& blocks) const {
   constexpr int kSegmentStates = 20;
+  const bool segments = linear_solver == "sparse_full";
   const std::set<const double*> in_prior = BlocksInPriors();
+  std::map<StateId, int> place;  // sparse_full: each state's place in id order
+  if (segments) {
+    for (const auto& [id, s] : states_) place.emplace(id, static_cast<int>(place.size()));
+  }
+  const auto segment = [&](StateId id) { return place.at(id) / kSegmentStates; };
   std::unordered_map<const double*, int> group;
-  std::map<StateId, int> segment;
-  int k = 0;
-  for (const auto& [id, s] : states_) {
-    const bool separator = linear_solver != "sparse_full" || k % kSegmentStates == kSegmentStates - 1;
-    segment[id] = k++ / kSegmentStates;
-    group[s.pose] = group[s.speed_bias] = separator ? 1 : 0;
+  for (const double* block : blocks) {
+    const BlockKey& key = block_keys_.at(block);
+    if (key.kind == BlockKey::Kind::kPose || key.kind == BlockKey::Kind::kSpeedBias) {
+      const bool separator = !segments || place.at(StateId(key.id)) % kSegmentStates == kSegmentStates - 1;
+      group[block] = separator ? 1 : 0;
+    } else if (key.kind == BlockKey::Kind::kLandmark) {
+      const Landmark& landmark = landmarks_.at(LandmarkId(key.id));
+      const bool one_segment = !segments || landmark.observed_from.empty() ||
+                               segment(*landmark.observed_from.begin()) == segment(*landmark.observed_from.rbegin());
+      const bool eliminable = landmark.anchored_to.empty() && !in_prior.count(landmark.p_w);
+      group[block] = one_segment && eliminable ? 0 : 1;
+    } else {
+      group[block] = 1;  // calibration: seen by every observation
+    }
   }
-  for (const auto& [id, landmark] : landmarks_) {
-    const bool one_segment = linear_solver != "sparse_full" || landmark.observed_from.empty() ||
-                             segment.at(*landmark.observed_from.begin()) == segment.at(*landmark.observed_from.rbegin());
-    const bool eliminable = landmark.anchored_to.empty() && !in_prior.count(landmark.p_w);
-    group[landmark.p_w] = one_segment && eliminable ? 0 : 1;
-  }
-  for (const double* block : CalibrationBlocks()) group[block] = 1;  // seen by every observation
   return group;
 }
 
@@ -202,7 +231,7 @@ SolveReport Window::SolveCopy(const SolverOptions& options, const std::vector<ce
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem copy(problem_options);
-  const std::unordered_map<const double*, int> groups = EliminationGroups(options.linear_solver);
+  const std::unordered_map<const double*, int> groups = EliminationGroups(options.linear_solver, ids.blocks);
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (const double* block : ids.blocks) {
     double* c = ids.copy_of.at(block);
@@ -226,6 +255,7 @@ SolveReport Window::SolveCopy(const SolverOptions& options, const std::vector<ce
   solver.callbacks.push_back(&control);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &copy, &summary);
+  VLOG(2) << "sparse solve of " << ids.blocks.size() << " blocks: " << summary.BriefReport();
   SolveReport report;
   report.iterations = static_cast<int>(summary.iterations.size());
   report.initial_cost = summary.initial_cost;

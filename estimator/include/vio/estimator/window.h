@@ -326,7 +326,9 @@ class Window {
   /// The variable blocks' Leaving, with the calibration blocks that are estimated and variable.
   Leaving SolvedOf(const VariableIds& variable);
   IdOrderedCopy CopyOf(const std::vector<ceres::ResidualBlockId>& residuals, const LandmarkFactors& extra) const;
-  std::unordered_map<const double*, int> EliminationGroups(const std::string& linear_solver) const;
+  /// The elimination group of each of `blocks` (states, landmarks, calibration).
+  std::unordered_map<const double*, int> EliminationGroups(const std::string& linear_solver,
+                                                           const std::vector<const double*>& blocks) const;
   SolveReport SolveCopy(const SolverOptions& options, const std::vector<ceres::ResidualBlockId>& residuals,
                         const LandmarkFactors& extra, const IdOrderedCopy& ids);
   /// The residuals SolveSparse(options, frozen) copies: those of the variable states (priors, IMU
@@ -356,6 +358,7 @@ class Window {
   /// Drops `observations`, and a landmark left unobserved that no prior holds.
   void DropOutlierObservations(const std::vector<ObservationKey>& observations);
   void RemoveStateBookkeeping(StateId id);
+  void RemoveLandmarkBookkeeping(LandmarkId id);
   /// The keys of `residuals` (observations_ or anchored_points_) on what leaves; `by`: the
   /// landmark's states with such a residual.
   template <typename Residuals>
@@ -383,6 +386,12 @@ class Window {
   std::unique_ptr<ceres::Problem> problem_;
   std::map<StateId, State> states_;
   std::map<LandmarkId, Landmark> landmarks_;
+  /// The states and landmarks not held constant (Set*Constant), kept as they change: a solve's
+  /// variables without a walk over everything the window keeps.
+  std::set<StateId> variable_states_;
+  std::set<LandmarkId> variable_landmarks_;
+  /// The key of every state, landmark and calibration block (a lookup only: copies are ordered by key).
+  std::unordered_map<const double*, BlockKey> block_keys_;
   std::map<StateId, ImuEdge> imu_edges_;  ///< keyed by the later state (`to`)
   std::map<ObservationKey, Observation> observations_;
   std::map<ObservationKey, ceres::ResidualBlockId> anchored_points_;
