@@ -4,7 +4,7 @@
 # IMU's (`vio simulate --time_offset_ms`) and with sensor.yaml's camera-IMU
 # extrinsics off by 1 deg / 1.5 cm and 2 deg / 3 cm (`--extrinsic_error_deg/_m`,
 # axis and direction from the default seed), each run with swf and msckf 10 and
-# default flags. Prints a Markdown table: the clean run's ATE (SE3) and, for each
+# default flags, the extrinsic errors also with the probe (--extrinsics_probe_s=30). Prints a Markdown table: the clean run's ATE (SE3) and, for each
 # error, the run's ATE against the clean run's / the time offset's final error
 # [ms] / the rig's rotation error at the end [deg] (the calibration folder the
 # run writes, or the sensor.yaml it read, against the sequence's own sensor.yaml,
@@ -24,9 +24,13 @@ declare -A case_flags=([clean]="" [td-30]="--time_offset_ms=-30" [td-15]="--time
                        [td+15]="--time_offset_ms=15" [td+30]="--time_offset_ms=30"
                        [rig1]="--extrinsic_error_deg=1 --extrinsic_error_m=0.015"
                        [rig2]="--extrinsic_error_deg=2 --extrinsic_error_m=0.03")
-cases=(clean td-30 td-15 td+15 td+30 rig1 rig2)
+datasets=(clean td-30 td-15 td+15 td+30 rig1 rig2)
+# A case: a dataset, and the run's flags beyond the defaults.
+cases=(clean td-30 td-15 td+15 td+30 rig1 rig2 rig1+probe rig2+probe)
+declare -A run_flags=([rig1+probe]="--extrinsics_probe_s=30" [rig2+probe]="--extrinsics_probe_s=30")
 declare -A case_titles=([td-30]="-30 ms" [td-15]="-15 ms" [td+15]="+15 ms" [td+30]="+30 ms"
-                        [rig1]="1 deg / 1.5 cm" [rig2]="2 deg / 3 cm")
+                        [rig1]="1 deg / 1.5 cm" [rig2]="2 deg / 3 cm"
+                        [rig1+probe]="1 deg / 1.5 cm, probe" [rig2+probe]="2 deg / 3 cm, probe")
 
 simulate() {  # SEQ CASE
   local dir="$out/data/$1_$2"
@@ -37,15 +41,16 @@ simulate() {  # SEQ CASE
 run() {  # SEQ CASE POLICY
   local dir="$out/runs/$1_$2_$3"
   [ -f "$dir/summary.json" ] && return
-  nice "$vio" run --dataset="$out/data/$1_$2" --config="$config" --policy="$3" --window_size=10 \
-    --output_dir="$dir" >"$dir.log" 2>&1 || true
+  # shellcheck disable=SC2086
+  nice "$vio" run --dataset="$out/data/$1_${2%+*}" --config="$config" --policy="$3" --window_size=10 \
+    ${run_flags[$2]:-} --output_dir="$dir" >"$dir.log" 2>&1 || true
 }
 # shellcheck source=tools/table_lib.sh
 source "$root/tools/table_lib.sh"   # queue, ate
 
 jobs=()
 for seq in "${sequences[@]}"; do
-  for c in "${cases[@]}"; do queue simulate "$seq" "$c"; done
+  for d in "${datasets[@]}"; do queue simulate "$seq" "$d"; done
 done
 wait
 jobs=()
@@ -103,7 +108,7 @@ for seq in "${sequences[@]}"; do
     for c in "${cases[@]:1}"; do
       dir="$out/runs/${seq}_${c}_${policy}"
       a=$(ate "$dir/trajectory.txt" "$gt")
-      read -r status offset rig < <(errors "$dir" "$out/data/${seq}_${c}" "$seq")
+      read -r status offset rig < <(errors "$dir" "$out/data/${seq}_${c%+*}" "$seq")
       ratio=$(python3 -c "import sys; a,b=float(sys.argv[1]),float(sys.argv[2]); print('%.2fx' % (a/b) if b==b and b>0 and a==a else 'n/a')" "$a" "$clean")
       row+=" $ratio / $offset / $rig$([ "$status" = ok ] || echo " ($status)") |"
     done

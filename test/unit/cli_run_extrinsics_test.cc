@@ -45,7 +45,7 @@ RunResult RunWith(const std::string& dataset, const std::string& policy, bool es
   request.show_progress = false;
   request.config.estimator.policy.policy = policy;
   request.config.estimator.model.estimate_extrinsics = estimate;
-  if (!probe) request.config.estimator.model.extrinsics_probe_s = 0;
+  request.config.estimator.model.extrinsics_probe_s = probe ? 30.0 : 0.0;
   // The simulator's IMU noise is the datasheet's: the matching model (cli_run_time_offset_test).
   request.config.estimator.model.imu_noise_scale = 1.0;
   return RunDataset(request);
