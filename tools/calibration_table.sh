@@ -42,7 +42,7 @@ run() {  # SEQ CASE POLICY
   local dir="$out/runs/$1_$2_$3"
   [ -f "$dir/summary.json" ] && return
   # shellcheck disable=SC2086
-  nice "$vio" run --dataset="$out/data/$1_${2%+*}" --config="$config" --policy="$3" --window_size=10 \
+  nice "$vio" run --dataset="$out/data/$1_${2%+probe}" --config="$config" --policy="$3" --window_size=10 \
     ${run_flags[$2]:-} --output_dir="$dir" >"$dir.log" 2>&1 || true
 }
 # shellcheck source=tools/table_lib.sh
@@ -108,7 +108,7 @@ for seq in "${sequences[@]}"; do
     for c in "${cases[@]:1}"; do
       dir="$out/runs/${seq}_${c}_${policy}"
       a=$(ate "$dir/trajectory.txt" "$gt")
-      read -r status offset rig < <(errors "$dir" "$out/data/${seq}_${c%+*}" "$seq")
+      read -r status offset rig < <(errors "$dir" "$out/data/${seq}_${c%+probe}" "$seq")
       ratio=$(python3 -c "import sys; a,b=float(sys.argv[1]),float(sys.argv[2]); print('%.2fx' % (a/b) if b==b and b>0 and a==a else 'n/a')" "$a" "$clean")
       row+=" $ratio / $offset / $rig$([ "$status" = ok ] || echo " ($status)") |"
     done
