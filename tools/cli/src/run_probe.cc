@@ -25,24 +25,12 @@ bool ExtrinsicsProbe::Update(Timestamp t_ns, Estimator& estimator) {
   next_check_ns_ = t_ns + SecondsToNanos(kCheckS);
   const std::optional<Eigen::Matrix<double, 6, 6>> covariance = estimator.ExtrinsicCovariance();
   const bool time_up = t_ns - start_ns_ >= SecondsToNanos(model_.extrinsics_probe_s);
-  if (!time_up && !SigmasBelow(covariance, kSettledFraction)) return false;
-  // A significant correction is measured on until it is good to a fraction of the sizes that matter.
-  if (Measure(t_ns, estimator, covariance).applied && !SigmasBelow(covariance, kRefinedFraction)) {
-    if (!refining_) {
-      LOG(INFO) << "extrinsics probe after " << NanosToSeconds(t_ns - start_ns_) << " s: a significant correction; "
-                << "measuring on until its sigmas are below " << kRefinedFraction << " of extrinsics_probe_min_deg / _m";
-      refining_ = true;
-    }
-    return false;
-  }
+  const bool settled =
+      covariance && LargestSigma(covariance->topLeftCorner<3, 3>()) < 0.5 * model_.extrinsics_probe_min_deg * M_PI / 180.0 &&
+      LargestSigma(covariance->bottomRightCorner<3, 3>()) < 0.5 * model_.extrinsics_probe_min_m;
+  if (!time_up && !settled) return false;
   Decide(t_ns, estimator, covariance);
   return true;
-}
-
-bool ExtrinsicsProbe::SigmasBelow(const std::optional<Eigen::Matrix<double, 6, 6>>& covariance, double fraction) const {
-  return covariance &&
-         LargestSigma(covariance->topLeftCorner<3, 3>()) < fraction * model_.extrinsics_probe_min_deg * M_PI / 180.0 &&
-         LargestSigma(covariance->bottomRightCorner<3, 3>()) < fraction * model_.extrinsics_probe_min_m;
 }
 
 void ExtrinsicsProbe::Finish(Estimator& estimator) {
@@ -51,8 +39,8 @@ void ExtrinsicsProbe::Finish(Estimator& estimator) {
   Decide(last_ns_, estimator, start_ns_ < 0 ? std::nullopt : estimator.ExtrinsicCovariance());
 }
 
-CalibrationReport::ExtrinsicsProbe ExtrinsicsProbe::Measure(
-    Timestamp t_ns, Estimator& estimator, const std::optional<Eigen::Matrix<double, 6, 6>>& covariance) const {
+void ExtrinsicsProbe::Decide(Timestamp t_ns, Estimator& estimator,
+                             const std::optional<Eigen::Matrix<double, 6, 6>>& covariance) {
   const Window& window = estimator.window();
   const Eigen::Matrix<double, 6, 1> c = window.extrinsic_correction();
   CalibrationReport::ExtrinsicsProbe report;
@@ -69,13 +57,6 @@ CalibrationReport::ExtrinsicsProbe ExtrinsicsProbe::Measure(
   const bool large = report.rotation_deg.norm() >= model_.extrinsics_probe_min_deg ||
                      report.translation_m.norm() >= model_.extrinsics_probe_min_m;
   report.applied = report.chi2 && *report.chi2 > kChi2 && large;
-  return report;
-}
-
-void ExtrinsicsProbe::Decide(Timestamp t_ns, Estimator& estimator,
-                             const std::optional<Eigen::Matrix<double, 6, 6>>& covariance) {
-  const Window& window = estimator.window();
-  const CalibrationReport::ExtrinsicsProbe report = Measure(t_ns, estimator, covariance);
   rig_ = window.estimated_stereo();
   std::ostringstream what;
   what << std::fixed << std::setprecision(3) << "extrinsics probe after " << report.duration_s

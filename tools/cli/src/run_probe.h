@@ -21,8 +21,7 @@ class ExtrinsicsProbe {
   /// After the estimate of the frame at t_ns (the run initialized): once the searches at
   /// initialization decided, checks the correction's covariance every kCheckS of frame time and
   /// decides when its sigmas are below half the smallest corrections that matter or extrinsics_probe_s
-  /// has passed since the first estimate; a significant correction only once they are below a quarter
-  /// (or at the data's end). True once decided.
+  /// has passed since the first estimate. True once decided.
   bool Update(Timestamp t_ns, Estimator& estimator);
   /// The data ended before the probe decided: it decides with what the window has.
   void Finish(Estimator& estimator);
@@ -37,25 +36,14 @@ class ExtrinsicsProbe {
   static constexpr double kCheckS = 1.0;
   /// The chi-square threshold of a 6-dof correction: 0.1 % of a zero correction's draws exceed it.
   static constexpr double kChi2 = 22.46;
-  /// The probe decides once its sigmas are below this fraction of extrinsics_probe_min_deg / _m (or
-  /// extrinsics_probe_s has passed); a significant correction is then measured on until they are
-  /// below kRefinedFraction of them (or the data ends): a few millimetres of the rig's translation
-  /// left cost 1.1x the ATE.
-  static constexpr double kSettledFraction = 0.5;
-  static constexpr double kRefinedFraction = 0.25;
 
  private:
-  bool SigmasBelow(const std::optional<Eigen::Matrix<double, 6, 6>>& covariance, double fraction) const;
-  /// The correction the window holds now, with its sigmas, and whether it would be applied.
-  CalibrationReport::ExtrinsicsProbe Measure(Timestamp t_ns, Estimator& estimator,
-                                             const std::optional<Eigen::Matrix<double, 6, 6>>& covariance) const;
   void Decide(Timestamp t_ns, Estimator& estimator, const std::optional<Eigen::Matrix<double, 6, 6>>& covariance);
 
   ModelOptions model_;
   Timestamp start_ns_ = -1;       ///< the first estimate's frame
   Timestamp next_check_ns_ = -1;  ///< the next covariance check
   Timestamp last_ns_ = -1;        ///< the last frame seen
-  bool refining_ = false;         ///< a significant correction is being measured on
   std::optional<CalibrationReport::ExtrinsicsProbe> report_;
   RectifiedStereo rig_;
 };
