@@ -3,7 +3,7 @@
 // simulated with the true rig): SWF and MSCKF recover the rotation to within 0.1 deg and track as
 // with the state on the clean flight, where the correction stays near zero. The state itself
 // costs accuracy (measured: 1.35x SWF, 1.23x MSCKF the ATE with the rig held on the clean flight).
-// The extrinsics probe, on by default, is held off but in its own test (last).
+// The extrinsics probe (off by default) runs in its own test (last).
 #include <cmath>
 #include <fstream>
 #include <sstream>
