@@ -12,6 +12,7 @@ PolicyTiming SmootherPolicy::Update(const StereoFrame& frame, StateId new_state,
   auto start = std::chrono::steady_clock::now();
   active_.insert(new_state);
   AddToKeptProblem(frame, new_state, options_.model, window);
+  if (!window.ObservationsOf(new_state).empty()) observing_.insert(new_state);
   FreeMoved(window);
   window.RefreshImuFactors(options_.model.reintegrate_bias_threshold, std::min(refresh_from_, *active_.begin()));
   timing.build_ms = MillisecondsSince(start);
@@ -82,18 +83,26 @@ void SmootherPolicy::Free(StateId id, Window& window) {
   auto it = held_.find(id);
   for (const SummarizedObservation& part : it->second) RemoveFromSummary(part, frozen_);
   held_.erase(it);
+  if (!window.ObservationsOf(id).empty()) observing_.insert(id);
   window.SetStateConstant(id, false);
   for (const auto& [landmark, z] : window.ObservationsOf(id)) window.SetLandmarkConstant(landmark, false);
   active_.insert(id);
   ++freed_;
 }
 
+// A state is held once `smoother_active_states` newer states observe landmarks: the IMU-only
+// states of a tracking loss stay solved until that many tracked frames follow it, so the stretch
+// the IMU bridged bends to fit the frames on both ends (held, it would keep its dead reckoning).
 void SmootherPolicy::HoldOld(Window& window) {
   std::set<LandmarkId> seen;
   const int keep = options_.smoother.smoother_active_states;
-  while (static_cast<int>(active_.size()) > keep) {
+  const auto newer_observing = [this] {
+    return static_cast<int>(observing_.size()) - static_cast<int>(observing_.count(*active_.begin()));
+  };
+  while (static_cast<int>(active_.size()) > keep && newer_observing() >= keep) {
     const StateId oldest = *active_.begin();
     active_.erase(active_.begin());
+    observing_.erase(oldest);
     std::vector<SummarizedObservation>& parts = held_[oldest];
     window.SummarizeObservationsOf(oldest, frozen_, &parts);
     window.SetStateConstant(oldest, true);

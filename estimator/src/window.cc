@@ -171,7 +171,7 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
   const ObservationKey key{state_id, landmark_id};
   CHECK(observations_.count(key) == 0) << "landmark " << landmark_id.value << " observed twice in state "
                                       << state_id.value;
-  // The pose, the landmark, then CalibrationBlocks() in its order (time offset, extrinsics).
+  // The pose, the landmark, then the calibration blocks in CalibrationBlocks()' order.
   constexpr std::size_t kMostBlocks = 4;
   std::vector<double*> blocks;
   std::vector<BlockKey> keys;
@@ -181,13 +181,9 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
   blocks.push_back(it->second.p_w);
   keys.push_back(BlockKey::Pose(state_id));
   keys.push_back(BlockKey::Landmark(landmark_id));
-  if (estimates_time_offset()) {
-    blocks.push_back(time_offset_);
-    keys.push_back(BlockKey::TimeOffset());
-  }
-  if (estimates_extrinsics()) {
-    blocks.push_back(extrinsic_);
-    keys.push_back(BlockKey::Extrinsics());
+  for (const auto& [block, key] : KeyedCalibrationBlocks()) {
+    blocks.push_back(block);
+    keys.push_back(key);
   }
   const ceres::ResidualBlockId residual = problem_->AddResidualBlock(
       WithFirstEstimates(Wrap(StereoFactorOf(state_id, landmark_id, z_px)), std::move(keys)), loss_.get(), blocks);

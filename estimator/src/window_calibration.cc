@@ -47,10 +47,16 @@ void Window::EstimateExtrinsics(double sigma_rad, double sigma_m) {
   HoldFirstEstimates({extrinsic_});
 }
 
+std::vector<std::pair<double*, BlockKey>> Window::KeyedCalibrationBlocks() const {
+  std::vector<std::pair<double*, BlockKey>> blocks;
+  if (estimates_time_offset()) blocks.emplace_back(const_cast<double*>(time_offset_), BlockKey::TimeOffset());
+  if (estimates_extrinsics()) blocks.emplace_back(const_cast<double*>(extrinsic_), BlockKey::Extrinsics());
+  return blocks;
+}
+
 std::vector<double*> Window::CalibrationBlocks() const {
   std::vector<double*> blocks;
-  if (estimates_time_offset()) blocks.push_back(const_cast<double*>(time_offset_));
-  if (estimates_extrinsics()) blocks.push_back(const_cast<double*>(extrinsic_));
+  for (const auto& [block, key] : KeyedCalibrationBlocks()) blocks.push_back(block);
   return blocks;
 }
 

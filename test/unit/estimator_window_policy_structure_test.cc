@@ -82,6 +82,7 @@ struct FrameRecord {
   Ids landmarks;               ///< in the window afterwards
   Ids marginalized_states;
   Ids marginalized_landmarks;
+  Ids held_states;             ///< held constant afterwards
   int solver_iterations = 0;
 };
 
@@ -93,19 +94,24 @@ Ids ToIds(const T& ids) {
 }
 
 /// Runs the policy over the script: each frame a state at the ground truth
-/// (5 cm off), linked by its IMU factor, then the policy's Update.
-std::vector<FrameRecord> RunScript(const EstimatorOptions& options) {
+/// (5 cm off), linked by its IMU factor, then the policy's Update; the frames in
+/// `lost` without observations (a tracking loss).
+std::vector<FrameRecord> RunScript(const EstimatorOptions& options, const Ids& lost = {}) {
   ModelOptions model = options.model;
   Window window(model, Flight().stereo());
   std::unique_ptr<Policy> policy = MakePolicy(options);
   std::vector<FrameRecord> records;
   for (int k = 0; k < kFrames; ++k) {
-    const StereoFrame frame = ScriptedFrame(k);
+    StereoFrame frame = ScriptedFrame(k);
+    if (lost.count(k)) frame.observations.clear();
     Flight().AddState(window, kFirst, k, Eigen::Vector3d(0.05, 0, 0));
     window.ClearRemovals();
     const PolicyTiming timing = policy->Update(frame, StateId(k), window);
     FrameRecord record;
-    for (const auto& [id, state] : window.states()) record.states.insert(id.value);
+    for (const auto& [id, state] : window.states()) {
+      record.states.insert(id.value);
+      if (window.IsStateConstant(id)) record.held_states.insert(id.value);
+    }
     for (const auto& [id, landmark] : window.landmarks()) record.landmarks.insert(id.value);
     record.marginalized_states = ToIds(window.removals().marginalized_states);
     record.marginalized_landmarks = ToIds(window.removals().marginalized_landmarks);
@@ -251,6 +257,32 @@ TEST(PolicyStructure, EkfMarginalizesThePreviousStateAndKeepsEveryLandmark) {
     for (const int id : limited[k].landmarks) EXPECT_TRUE(unseen[k].landmarks.count(id) > 0);
   }
   EXPECT_TRUE(full);
+}
+
+// The smoother(3) holds a state once 3 newer states observe landmarks: through a
+// tracking loss (frames 4-7 without observations) the IMU-only states stay solved
+// with the 3 tracked states before them, and are held only after 3 tracked frames
+// follow (frame 10); the states are all kept.
+TEST(PolicyStructure, SmootherHoldsATrackingLossOnlyAfterTrackedFramesFollowIt) {
+  EstimatorOptions options = Options("smoother", 10);
+  options.smoother.smoother_active_states = 3;
+  const std::vector<FrameRecord> tracked = RunScript(options);
+  const std::vector<FrameRecord> loss = RunScript(options, {4, 5, 6, 7});
+  const std::map<int, Ids> held_after_loss = {{3, {0}},          {4, {0}},           {5, {0}},
+                                              {6, {0}},          {7, {0}},           {8, {0, 1}},
+                                              {9, {0, 1, 2}},    {10, {0, 1, 2, 3, 4, 5, 6, 7}},
+                                              {11, {0, 1, 2, 3, 4, 5, 6, 7, 8}},
+                                              {12, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9}}};
+  for (int k = 0; k < kFrames; ++k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    Ids every, held;
+    for (int i = 0; i <= k; ++i) every.insert(i);
+    for (int i = 0; i <= k - 3; ++i) held.insert(i);
+    EXPECT_EQ(tracked[k].states, every);
+    EXPECT_EQ(tracked[k].held_states, held);
+    EXPECT_EQ(loss[k].states, every);
+    EXPECT_EQ(loss[k].held_states, held_after_loss.count(k) ? held_after_loss.at(k) : Ids{});
+  }
 }
 
 }  // namespace

@@ -169,7 +169,7 @@ struct BatchOptions {
 /// the newest states and the older ones whose pending step is large are solved, the rest
 /// held with their observations summarized per landmark.
 struct SmootherOptions {
-  int smoother_active_states = 10;             ///< newest states solved every frame [frames]
+  int smoother_active_states = 10;             ///< newest tracked states solved every frame [frames]
   double smoother_relinearize_threshold = 1e-3;  ///< an older state's pending step that frees it [m or rad]
   int smoother_checks_per_frame = 4;           ///< older states whose pending step is checked per frame [count]
   int smoother_full_every = 0;                 ///< every this many frames every state is solved; 0 = never [frames]
@@ -177,7 +177,10 @@ struct SmootherOptions {
   template <class V>
   void Visit(V& v) {
     v("smoother_active_states", smoother_active_states,
-      "smoother: the newest states, solved every frame (the older ones are held unless freed) [frames]", AtLeast(1));
+      "smoother: the newest states that observe landmarks, solved every frame with every later state (a tracking "
+      "loss's IMU-only states stay solved until that many tracked frames follow them); the older ones are held "
+      "unless freed [frames]",
+      AtLeast(1));
     v("smoother_relinearize_threshold", smoother_relinearize_threshold,
       "smoother: an older state joins the frame's solve when its Gauss-Newton step alone (position [m] or "
       "rotation [rad]) exceeds this [m or rad]",

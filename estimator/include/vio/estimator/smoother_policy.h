@@ -2,8 +2,10 @@
 // The incremental smoother: every state and landmark kept, as batch, but each
 // frame solved towards the maximum a posteriori estimate from the data so far
 // (the online trajectory is written frame by frame). Each frame solves the
-// newest `smoother_active_states` states, the landmarks they see and the older
-// states whose pending step is large; every other state is held constant, its
+// states from the `smoother_active_states`-th newest that observes landmarks on
+// (a tracking loss's IMU-only states stay solved until that many tracked frames
+// follow them), the landmarks they see and the older states whose pending step
+// is large; every other state is held constant, its
 // observations summarized in its landmarks' quadratic models
 // (frozen_observations.h). The relinearization test (iSAM2's idea on the held
 // states): a held state's Gauss-Newton step alone, over the residuals on it at
@@ -40,11 +42,12 @@ class SmootherPolicy final : public Policy {
   /// Frees the checked states whose pending step exceeds the threshold.
   void FreeMoved(Window& window);
   void Free(StateId state, Window& window);
-  /// Holds every active state but the newest smoother_active_states.
+  /// Holds every active state older than the newest smoother_active_states that observe landmarks.
   void HoldOld(Window& window);
 
   EstimatorOptions options_;
   std::set<StateId> active_;  ///< states solved this frame, oldest first
+  std::set<StateId> observing_;  ///< the active states that observe landmarks (not a tracking loss's)
   std::map<StateId, std::vector<SummarizedObservation>> held_;  ///< each held state's summarized observations
   FrozenObservations frozen_;
   StateId cursor_{std::numeric_limits<std::int64_t>::min()};   ///< the round of checks goes on after it

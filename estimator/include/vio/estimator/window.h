@@ -401,7 +401,9 @@ class Window {
   std::map<StateId, CameraTiming> camera_timing_;
   double extrinsic_[6] = {};       ///< c = (dtheta, dp); a parameter block once EstimateExtrinsics was called
   Prior extrinsic_prior_;          ///< also in priors_; null residual: not estimated
-  /// The estimated calibration blocks (time offset, then extrinsics), in that order.
+  /// The estimated calibration blocks (time offset, then extrinsics), in that order, with their keys.
+  std::vector<std::pair<double*, BlockKey>> KeyedCalibrationBlocks() const;
+  /// KeyedCalibrationBlocks()' blocks alone.
   std::vector<double*> CalibrationBlocks() const;
   /// The marginal covariance of `block` (a calibration block), as TimeOffsetSigma.
   std::optional<Eigen::MatrixXd> CalibrationCovariance(const double* block);
