@@ -48,13 +48,6 @@ double ApplyLoss(const ceres::LossFunction& loss, Eigen::Map<Eigen::VectorXd> re
   return 0.5 * rho[0];
 }
 
-// An IMU residual's shape: 15 rows on tangents of 6 (poses) and 9 (speed/bias blocks).
-bool IsImuShaped(const Residual& residual) {
-  if (residual.rows != 15) return false;
-  return std::all_of(residual.slots.begin(), residual.slots.end(),
-                     [](const Slot& slot) { return !slot.variable() || slot.tangent == 6 || slot.tangent == 9; });
-}
-
 }  // namespace
 
 // J_i^T J_j into the upper block triangle of H.
@@ -95,19 +88,6 @@ bool BlockSystem::Impl::AddGeneric(const Residual& residual, double* cost) {
         use(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(data));
       } else {
         use(Eigen::Map<const Eigen::Vector3d>(data));
-      }
-    });
-    return true;
-  }
-  // An IMU residual likewise (a dynamic product costs several times a fixed one at 15 x 9).
-  if (IsImuShaped(residual)) {
-    using Rows15 = Eigen::Matrix<double, 15, 1>;
-    Accumulate(residual, Eigen::Map<const Rows15>(r.data()), [&](const Slot& slot, const auto& use) {
-      const double* data = jacobians.data() + slot.jacobian;
-      if (slot.tangent == 6) {
-        use(Eigen::Map<const Eigen::Matrix<double, 15, 6, Eigen::RowMajor>>(data));
-      } else {
-        use(Eigen::Map<const Eigen::Matrix<double, 15, 9, Eigen::RowMajor>>(data));
       }
     });
     return true;
