@@ -172,17 +172,10 @@ Eigen::MatrixXd ProbeVectors(Eigen::Index n) {
 /// may hold, when that is more; estimated on kProbes probe vectors: O(n^2)
 /// instead of the n^3 of forming Jp^T Jp. The failure it guards against
 /// (amplified round-off after a round-off pivot) is many orders above both.
-/// `upper`: Jp is upper triangular (an unpivoted factor), its products taken on that triangle.
-bool Reproduces(const Eigen::MatrixXd& Jp, const Eigen::MatrixXd& H, double dropped = 0.0, bool upper = false) {
+bool Reproduces(const Eigen::MatrixXd& Jp, const Eigen::MatrixXd& H, double dropped = 0.0) {
   const Eigen::MatrixXd V = ProbeVectors(H.cols());
-  Eigen::MatrixXd error = -(H * V);
-  if (upper) {
-    const Eigen::MatrixXd JpV = Jp.triangularView<Eigen::Upper>() * V;
-    error.noalias() += Jp.transpose().triangularView<Eigen::Lower>() * JpV;
-  } else {
-    const Eigen::MatrixXd JpV = Jp * V;
-    error.noalias() += Jp.transpose() * JpV;
-  }
+  const Eigen::MatrixXd JpV = Jp * V;
+  const Eigen::MatrixXd error = Jp.transpose() * JpV - H * V;
   return error.norm() <= std::max(kReconstructionTolerance * H.norm(), dropped) * std::sqrt(static_cast<double>(kProbes));
 }
 
@@ -199,7 +192,7 @@ std::optional<SqrtInformation> SqrtByCholesky(const Eigen::MatrixXd& H_symmetric
   const double cutoff = EigenvalueCutoff(H_symmetric.diagonal().maxCoeff(), threshold);
   if (!(llt.matrixLLT().diagonal().array().square() > cutoff).all()) return std::nullopt;
   SqrtInformation sqrt{llt.matrixU(), llt.matrixL().solve(b), Eigen::MatrixXd()};
-  if (!Reproduces(sqrt.sqrt_information, H_symmetric, 0.0, /*upper=*/true)) return std::nullopt;
+  if (!Reproduces(sqrt.sqrt_information, H_symmetric)) return std::nullopt;
   return sqrt;
 }
 
