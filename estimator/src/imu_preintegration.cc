@@ -17,23 +17,60 @@ namespace vio {
 namespace {
 
 using Matrix15d = ImuPreintegration::Matrix15d;
-using Matrix15x12d = Eigen::Matrix<double, 15, 12>;
 using imu_state_index::kBa;
 using imu_state_index::kBg;
 using imu_state_index::kP;
 using imu_state_index::kR;
 using imu_state_index::kV;
 
-// Noise columns of G: [n_g, n_a, n_bg, n_ba].
-constexpr int kNoiseGyro = 0;
-constexpr int kNoiseAccel = 3;
-constexpr int kNoiseGyroWalk = 6;
-constexpr int kNoiseAccelWalk = 9;
-
-/// The linearization of one midpoint step: error_{k+1} = F error_k + G n.
+/// The linearization of one midpoint step, error_{k+1} = F error_k + G n with
+/// n = [n_g, n_a, n_bg, n_ba], by its non-zero 3 x 3 blocks (F is the
+/// identity elsewhere; G's measurement-noise columns are F's bias columns, its
+/// random-walk columns the identity on the bias rows):
+///   F_R = [dR^T, 0, 0, -Jr dt, 0]
+///   F_V = [dv_dphi, I, 0, dv_dbg, dv_dba]
+///   F_P = [dp_dphi, I dt, I, dp_dbg, dp_dba]
 struct StepLinearization {
-  Matrix15d F = Matrix15d::Identity();
-  Matrix15x12d G = Matrix15x12d::Zero();
+  Eigen::Matrix3d dR_transpose;
+  Eigen::Matrix3d minus_Jr_dt;
+  Eigen::Matrix3d dv_dphi, dv_dbg, dv_dba;
+  Eigen::Matrix3d dp_dphi, dp_dbg, dp_dba;
+  double dt = 0.0;
+
+  /// F X, on F's non-zero blocks only (a dense 15 x 15 product costs about 5x as much).
+  Matrix15d Times(const Matrix15d& X) const {
+    Matrix15d Y;
+    const auto x_r = X.middleRows<3>(kR);
+    const auto x_bg = X.middleRows<3>(kBg);
+    const auto x_ba = X.middleRows<3>(kBa);
+    Y.middleRows<3>(kR).noalias() = dR_transpose * x_r;
+    Y.middleRows<3>(kR).noalias() += minus_Jr_dt * x_bg;
+    Y.middleRows<3>(kV) = X.middleRows<3>(kV);
+    Y.middleRows<3>(kV).noalias() += dv_dphi * x_r;
+    Y.middleRows<3>(kV).noalias() += dv_dbg * x_bg;
+    Y.middleRows<3>(kV).noalias() += dv_dba * x_ba;
+    Y.middleRows<3>(kP) = X.middleRows<3>(kP) + dt * X.middleRows<3>(kV);
+    Y.middleRows<3>(kP).noalias() += dp_dphi * x_r;
+    Y.middleRows<3>(kP).noalias() += dp_dbg * x_bg;
+    Y.middleRows<3>(kP).noalias() += dp_dba * x_ba;
+    Y.middleRows<6>(kBg) = X.middleRows<6>(kBg);
+    return Y;
+  }
+
+  /// G diag(q) G^T added to `covariance` for the noise variances q (each the
+  /// same on its three axes): the measurement noise through F's bias columns,
+  /// the random walks on the bias rows.
+  void AddNoise(double gyro, double accel, double gyro_walk, double accel_walk, Matrix15d* covariance) const {
+    static_assert(kV == kR + 3 && kP == kV + 3, "rotation, velocity and position rows are contiguous");
+    Eigen::Matrix<double, 9, 3> g_gyro;
+    g_gyro << minus_Jr_dt, dv_dbg, dp_dbg;
+    Eigen::Matrix<double, 6, 3> g_accel;
+    g_accel << dv_dba, dp_dba;
+    covariance->block<9, 9>(kR, kR).noalias() += gyro * g_gyro * g_gyro.transpose();
+    covariance->block<6, 6>(kV, kV).noalias() += accel * g_accel * g_accel.transpose();
+    covariance->block<3, 3>(kBg, kBg).diagonal().array() += gyro_walk;
+    covariance->block<3, 3>(kBa, kBa).diagonal().array() += accel_walk;
+  }
 };
 
 /// F and G of one step (see the header comment for the step itself):
@@ -51,28 +88,17 @@ StepLinearization LinearizeStep(const Eigen::Matrix3d& R_k, const Eigen::Matrix3
       -0.5 * R_k * so3::Hat(accel_a) - 0.5 * R_k1_accel_b_hat * dR_transpose;
   const Eigen::Matrix3d dacc_dbg = 0.5 * R_k1_accel_b_hat * Jr_dt;
   const Eigen::Matrix3d dacc_dba = -0.5 * (R_k + R_k1);
-  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
 
   StepLinearization lin;
-  lin.F.block<3, 3>(kR, kR) = dR_transpose;
-  lin.F.block<3, 3>(kR, kBg) = -Jr_dt;
-  lin.F.block<3, 3>(kV, kR) = dacc_dphi * dt;
-  lin.F.block<3, 3>(kV, kBg) = dacc_dbg * dt;
-  lin.F.block<3, 3>(kV, kBa) = dacc_dba * dt;
-  lin.F.block<3, 3>(kP, kR) = 0.5 * dacc_dphi * dt * dt;
-  lin.F.block<3, 3>(kP, kV) = I * dt;
-  lin.F.block<3, 3>(kP, kBg) = 0.5 * dacc_dbg * dt * dt;
-  lin.F.block<3, 3>(kP, kBa) = 0.5 * dacc_dba * dt * dt;
-
-  // Measurement noise enters exactly like the bias errors; random walks
-  // drive the bias errors.
-  lin.G.block<3, 3>(kR, kNoiseGyro) = lin.F.block<3, 3>(kR, kBg);
-  lin.G.block<3, 3>(kV, kNoiseGyro) = lin.F.block<3, 3>(kV, kBg);
-  lin.G.block<3, 3>(kP, kNoiseGyro) = lin.F.block<3, 3>(kP, kBg);
-  lin.G.block<3, 3>(kV, kNoiseAccel) = lin.F.block<3, 3>(kV, kBa);
-  lin.G.block<3, 3>(kP, kNoiseAccel) = lin.F.block<3, 3>(kP, kBa);
-  lin.G.block<3, 3>(kBg, kNoiseGyroWalk) = I;
-  lin.G.block<3, 3>(kBa, kNoiseAccelWalk) = I;
+  lin.dR_transpose = dR_transpose;
+  lin.minus_Jr_dt = -Jr_dt;
+  lin.dv_dphi = dacc_dphi * dt;
+  lin.dv_dbg = dacc_dbg * dt;
+  lin.dv_dba = dacc_dba * dt;
+  lin.dp_dphi = 0.5 * dacc_dphi * dt * dt;
+  lin.dp_dbg = 0.5 * dacc_dbg * dt * dt;
+  lin.dp_dba = 0.5 * dacc_dba * dt * dt;
+  lin.dt = dt;
   return lin;
 }
 
@@ -184,14 +210,11 @@ void ImuPreintegration::Propagate(const Step& step) {
   const Eigen::Vector3d acc = 0.5 * (R_k * accel_a + R_k1 * accel_b);
 
   const StepLinearization lin = LinearizeStep(R_k, R_k1, theta, accel_a, accel_b, dt);
-  Eigen::Matrix<double, 12, 1> noise_variance;
-  noise_variance << Eigen::Vector3d::Constant(gyro_noise_density_ * gyro_noise_density_ / dt),
-      Eigen::Vector3d::Constant(accel_noise_density_ * accel_noise_density_ / dt),
-      Eigen::Vector3d::Constant(gyro_random_walk_ * gyro_random_walk_ * dt),
-      Eigen::Vector3d::Constant(accel_random_walk_ * accel_random_walk_ * dt);
-  covariance_ = lin.F * covariance_ * lin.F.transpose() +
-                lin.G * noise_variance.asDiagonal() * lin.G.transpose();
-  jacobian_ = lin.F * jacobian_;
+  // F P F^T = F (F P)^T, P symmetric.
+  covariance_ = lin.Times(lin.Times(covariance_).transpose());
+  lin.AddNoise(gyro_noise_density_ * gyro_noise_density_ / dt, accel_noise_density_ * accel_noise_density_ / dt,
+               gyro_random_walk_ * gyro_random_walk_ * dt, accel_random_walk_ * accel_random_walk_ * dt, &covariance_);
+  jacobian_ = lin.Times(jacobian_);
 
   deltas_.delta_p += deltas_.delta_v * dt + 0.5 * acc * dt * dt;
   deltas_.delta_v += acc * dt;

@@ -296,6 +296,28 @@ SqrtInformation SqrtByPivotedCholesky(const Eigen::MatrixXd& H, const Eigen::Vec
   return sqrt;
 }
 
+/// SchurComplement through the Cholesky factor H_MM = L L^T when H_MM is
+/// clearly definite: with U = H_KM L^-T, H_KK - U U^T (a symmetric rank
+/// update) and b_K - U L^-1 b_M. Clearly definite: its smallest eigenvalue,
+/// at least 1 / trace(H_MM^-1) = 1 / |L^-1|_F^2, is above the cutoff of its
+/// largest, at most trace(H_MM); the pseudo-inverse is then the inverse. Empty
+/// otherwise (the eigen-decomposition decides what is dropped).
+std::optional<NormalEquations> SchurComplementByCholesky(const Eigen::MatrixXd& H, const Eigen::VectorXd& b,
+                                                         int keep_dim, int marg_dim, const RankThreshold& threshold) {
+  if (marg_dim == 0) return NormalEquations{SymmetricPart(H), b};
+  const Eigen::MatrixXd H_MM = SymmetricPart(H.bottomRightCorner(marg_dim, marg_dim));
+  const Eigen::LLT<Eigen::MatrixXd> llt(H_MM);
+  if (llt.info() != Eigen::Success) return std::nullopt;
+  const Eigen::MatrixXd L_inv = llt.matrixL().solve(Eigen::MatrixXd::Identity(marg_dim, marg_dim));
+  if (!(1.0 / L_inv.squaredNorm() > EigenvalueCutoff(H_MM.trace(), threshold))) return std::nullopt;
+  const Eigen::MatrixXd U = H.topRightCorner(keep_dim, marg_dim) * L_inv.transpose().triangularView<Eigen::Upper>();
+  NormalEquations marginal{SymmetricPart(H.topLeftCorner(keep_dim, keep_dim)), Eigen::VectorXd()};
+  marginal.H.selfadjointView<Eigen::Lower>().rankUpdate(U, -1.0);
+  marginal.H.triangularView<Eigen::StrictlyUpper>() = marginal.H.transpose();
+  marginal.b = b.head(keep_dim) - U * (L_inv * b.tail(marg_dim));
+  return marginal;
+}
+
 }  // namespace
 
 Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& H, const RankThreshold& threshold) {
@@ -320,6 +342,9 @@ NormalEquations SchurComplement(const Eigen::MatrixXd& H, const Eigen::VectorXd&
                                 int marg_dim, const RankThreshold& threshold) {
   RequireSizes(H, b, keep_dim, marg_dim, "SchurComplement");
   RequireFinite(H, b, "SchurComplement");
+  if (std::optional<NormalEquations> marginal = SchurComplementByCholesky(H, b, keep_dim, marg_dim, threshold)) {
+    return *std::move(marginal);
+  }
   const Eigen::MatrixXd H_MM_inv =
       PseudoInverse(H.bottomRightCorner(marg_dim, marg_dim), threshold);
   const Eigen::MatrixXd H_KM_H_MM_inv = H.topRightCorner(keep_dim, marg_dim) * H_MM_inv;
