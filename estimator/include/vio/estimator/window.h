@@ -265,7 +265,7 @@ class Window {
   /// `landmark` from `state` at the current estimate [sigma]; +inf when the
   /// landmark is (nearly) at or behind the camera.
   double WhitenedError(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px) const;
-  const RectifiedStereo& stereo() const { return stereo_; }
+  const RectifiedStereo& stereo() const { return *stereo_; }
   int num_priors() const { return static_cast<int>(priors_.size()); }
   const WindowHealth& health() const { return health_; }
   ceres::Problem& problem() { return *problem_; }
@@ -380,7 +380,9 @@ class Window {
   BlockKey KeyOf(const double* block) const;
 
   ModelOptions model_;
-  RectifiedStereo stereo_;
+  /// The given rig, one object that every stereo factor of the window shares (immutable: the
+  /// estimated correction is a parameter block).
+  std::shared_ptr<const RectifiedStereo> stereo_;
   std::unique_ptr<ceres::Manifold> pose_manifold_;
   std::unique_ptr<ceres::LossFunction> loss_;
   std::unique_ptr<ceres::Problem> problem_;
