@@ -66,11 +66,13 @@ void State::SetSpeedBias(const Eigen::Vector3d& v_w_b, const Eigen::Vector3d& b_
   sb << v_w_b, b_g, b_a;
 }
 
-Window::Window(const ModelOptions& model, const RectifiedStereo& stereo)
-    : model_(model), stereo_(std::make_shared<const RectifiedStereo>(stereo)), pose_manifold_(std::make_unique<PoseManifold>()) {
+Window::Window(const ModelOptions& model, const RectifiedStereo& stereo, ResidualIndex index)
+    : model_(model),
+      stereo_(std::make_shared<const RectifiedStereo>(stereo)),
+      pose_manifold_(std::make_unique<PoseManifold>()) {
   if (model_.huber_px > 0) loss_ = std::make_unique<ceres::HuberLoss>(model_.huber_px);
   ceres::Problem::Options options;
-  options.enable_fast_removal = true;
+  options.enable_fast_removal = index == ResidualIndex::kPerBlock;
   options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_ = std::make_unique<ceres::Problem>(options);

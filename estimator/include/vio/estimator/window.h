@@ -107,9 +107,15 @@ struct WindowHealth {
   int stopped_solves = 0;     ///< solves ended early by SolveControl::stop (their iterate is not converged)
 };
 
+/// How the window's Ceres problem finds the residuals of a parameter block. kPerBlock: every
+/// block keeps the set of its residuals (Ceres' enable_fast_removal), so removing a state or
+/// landmark costs what it touches; about 130 B per observation. kNone: no sets; a removal scans
+/// every residual: for windows that keep everything and remove little (batch, the refinement).
+enum class ResidualIndex { kPerBlock, kNone };
+
 class Window {
  public:
-  Window(const ModelOptions& model, const RectifiedStereo& stereo);
+  Window(const ModelOptions& model, const RectifiedStereo& stereo, ResidualIndex index = ResidualIndex::kPerBlock);
   ~Window();
   Window(const Window&) = delete;
   Window& operator=(const Window&) = delete;
