@@ -14,11 +14,19 @@
 #include "vio/estimator/stereo_motion.h"
 
 namespace vio {
+namespace {
+
+// Batch keeps every state and landmark: its window removes only re-preintegrated IMU factors.
+ResidualIndex ResidualIndexFor(const EstimatorOptions& options) {
+  return options.policy.policy == "batch" ? ResidualIndex::kNone : ResidualIndex::kPerBlock;
+}
+
+}  // namespace
 
 Estimator::Estimator(const EstimatorOptions& options, const ImuCalibration& imu, const RectifiedStereo& stereo)
     : options_(options),
       imu_calibration_(imu),
-      window_(options.model, stereo),
+      window_(options.model, stereo, ResidualIndexFor(options)),
       policy_(MakePolicy(options)),
       tracking_(options.policy.min_frame_features, options.policy.window_size),
       rig_limits_(RigLimitsFor(imu, options.model.gravity)) {
@@ -351,7 +359,8 @@ std::vector<FrameEstimate> Estimator::Refine(RefinementReport* report) const {
   };
   LandmarkStarts landmarks = log_->landmarks;
   for (const auto& [id, landmark] : window_.landmarks()) landmarks[id] = landmark.position();
-  Window whole(options_.model, window_.estimated_stereo());
+  // Every state and landmark of the run, nothing removed but the observations that do not evaluate at the start.
+  Window whole(options_.model, window_.estimated_stereo(), ResidualIndex::kNone);
   whole.SetSolveControl(window_.solve_control());
   *report = vio::Refine(*log_, start, landmarks, options_, whole);
   if (!report->usable) return refined;

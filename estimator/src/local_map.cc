@@ -199,13 +199,15 @@ void LocalMap::Summarize(StateId frame, StateId anchor, Window& window) {
     if (keyframe.observations.count(landmark) == 0) continue;
     if (!(window.WhitenedError(frame, landmark, z) <= gate_sigma_)) continue;
     const Landmark& l = window.landmark(landmark);
-    const StereoFactor factor(z, window.stereo(), pixel_sigma_);
     const double* parameters[2] = {f.pose, l.p_w};
     Eigen::Vector3d e0;
     Eigen::Matrix<double, 3, 6, Eigen::RowMajor> J_pose;
     Eigen::Matrix<double, 3, 3, Eigen::RowMajor> J_w;
     double* jacobians[2] = {J_pose.data(), J_w.data()};
-    if (!factor.EvaluateOnTangents(parameters, e0.data(), jacobians)) continue;
+    if (!StereoFactor::EvaluateAt(window.stereo(), z, 1.0 / pixel_sigma_, parameters, e0.data(), jacobians,
+                                  /*on_tangents=*/true)) {
+      continue;
+    }
     AnchoredPointSummary& summary = keyframe.anchored[landmark];
     summary.Add(R_w_a.transpose() * (l.position() - a.p_w_b()), e0, J_w * R_w_a);
     data_.landmarks[landmark].p_w = l.position();

@@ -1,5 +1,9 @@
 #include "vio/estimator/stereo_calibration_factor.h"
 
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
 namespace vio {
 namespace {
 
@@ -25,14 +29,20 @@ void ChainInto(const Eigen::Matrix3d& chain, double* jacobian) {
 
 }  // namespace
 
-StereoCalibrationFactor::StereoCalibrationFactor(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo,
-                                                 double sigma_px, const TimeOffset* time_offset, bool extrinsics)
-    : plain_(z_px, stereo, sigma_px),  // throws on sigma_px <= 0
-      extrinsic_(z_px, stereo, sigma_px),
-      stereo_(stereo),
+StereoCalibrationFactor::StereoCalibrationFactor(const Eigen::Vector3d& z_px,
+                                                 std::shared_ptr<const RectifiedStereo> stereo, double sigma_px,
+                                                 const TimeOffset* time_offset, bool extrinsics)
+    : z_px_(z_px),
+      stereo_(std::move(stereo)),
       sigma_px_(sigma_px),
       has_time_offset_(time_offset != nullptr),
       has_extrinsics_(extrinsics) {
+  if (stereo_ == nullptr) throw std::invalid_argument("StereoCalibrationFactor: the rig (stereo) is null");
+  if (!(sigma_px > 0.0)) {
+    std::ostringstream message;
+    message << "StereoCalibrationFactor: sigma_px must be > 0, got " << sigma_px;
+    throw std::invalid_argument(message.str());
+  }
   set_num_residuals(3);
   *mutable_parameter_block_sizes() = {7, 3};
   if (has_time_offset_) {
@@ -41,6 +51,11 @@ StereoCalibrationFactor::StereoCalibrationFactor(const Eigen::Vector3d& z_px, co
   }
   if (has_extrinsics_) mutable_parameter_block_sizes()->push_back(6);
 }
+
+StereoCalibrationFactor::StereoCalibrationFactor(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo,
+                                                 double sigma_px, const TimeOffset* time_offset, bool extrinsics)
+    : StereoCalibrationFactor(z_px, std::make_shared<const RectifiedStereo>(stereo), sigma_px, time_offset,
+                              extrinsics) {}
 
 bool StereoCalibrationFactor::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
   return EvaluateImpl(parameters, residuals, jacobians, /*on_tangents=*/false);
@@ -62,10 +77,10 @@ bool StereoCalibrationFactor::EvaluateImpl(double const* const* parameters, doub
     if (has_extrinsics_) inner_jacobians[2] = jacobians[extrinsics];
   }
   double** inner = jacobians != nullptr ? inner_jacobians : nullptr;
-  const ceres::CostFunction& stereo = has_extrinsics_ ? static_cast<const ceres::CostFunction&>(extrinsic_) : plain_;
-  const auto& tangent = has_extrinsics_ ? static_cast<const marginalization::TangentCostFunction&>(extrinsic_) : plain_;
-  const bool ok = on_tangents ? tangent.EvaluateOnTangents(inner_parameters, residuals, inner)
-                              : stereo.Evaluate(inner_parameters, residuals, inner);
+  const bool ok =
+      has_extrinsics_
+          ? StereoExtrinsicFactor::EvaluateAt(*stereo_, z_px_, sigma_px_, inner_parameters, residuals, inner, on_tangents)
+          : StereoFactor::EvaluateAt(*stereo_, z_px_, 1.0 / sigma_px_, inner_parameters, residuals, inner, on_tangents);
   if (!ok || !has_time_offset_) return ok;
   AddTimeOffset(parameters, residuals, jacobians, on_tangents);
   return true;
@@ -75,9 +90,9 @@ void StereoCalibrationFactor::AddTimeOffset(double const* const* parameters, dou
                                             bool on_tangents) const {
   const int time_offset = 2;
   const RectifiedStereo corrected =
-      has_extrinsics_ ? CorrectedStereo(stereo_, Eigen::Map<const Eigen::Matrix<double, 6, 1>>(parameters[3]))
+      has_extrinsics_ ? CorrectedStereo(*stereo_, Eigen::Map<const Eigen::Matrix<double, 6, 1>>(parameters[3]))
                       : RectifiedStereo{};
-  const RectifiedStereo& rig = has_extrinsics_ ? corrected : stereo_;
+  const RectifiedStereo& rig = has_extrinsics_ ? corrected : *stereo_;
   const Eigen::Map<const Eigen::Vector3d> p_w_b(parameters[0]);
   const Eigen::Quaterniond q_w_b = Eigen::Map<const Eigen::Quaterniond>(parameters[0] + 3).normalized();
   const Eigen::Map<const Eigen::Vector3d> p_w_l(parameters[1]);

@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <stdexcept>
+#include <utility>
 
 #include "vio/estimator/so3.h"
 
@@ -48,27 +49,32 @@ RectifiedStereo CorrectedStereo(const RectifiedStereo& stereo, const Eigen::Matr
   return corrected;
 }
 
-StereoExtrinsicFactor::StereoExtrinsicFactor(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo,
+StereoExtrinsicFactor::StereoExtrinsicFactor(const Eigen::Vector3d& z_px, std::shared_ptr<const RectifiedStereo> stereo,
                                              double sigma_px)
-    : z_px_(z_px), stereo_(stereo), sigma_px_(sigma_px) {
+    : z_px_(z_px), stereo_(std::move(stereo)), sigma_px_(sigma_px) {
+  if (stereo_ == nullptr) throw std::invalid_argument("StereoExtrinsicFactor: the rig (stereo) is null");
   if (!(sigma_px > 0.0)) throw std::invalid_argument("StereoExtrinsicFactor: sigma_px must be > 0");
 }
 
+StereoExtrinsicFactor::StereoExtrinsicFactor(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo,
+                                             double sigma_px)
+    : StereoExtrinsicFactor(z_px, std::make_shared<const RectifiedStereo>(stereo), sigma_px) {}
+
 bool StereoExtrinsicFactor::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
-  return EvaluateImpl(parameters, residuals, jacobians, /*on_tangents=*/false);
+  return EvaluateAt(*stereo_, z_px_, sigma_px_, parameters, residuals, jacobians, /*on_tangents=*/false);
 }
 
 bool StereoExtrinsicFactor::EvaluateOnTangents(double const* const* parameters, double* residuals,
                                                double** jacobians) const {
-  return EvaluateImpl(parameters, residuals, jacobians, /*on_tangents=*/true);
+  return EvaluateAt(*stereo_, z_px_, sigma_px_, parameters, residuals, jacobians, /*on_tangents=*/true);
 }
 
-bool StereoExtrinsicFactor::EvaluateImpl(double const* const* parameters, double* residuals, double** jacobians,
-                                         bool on_tangents) const {
+bool StereoExtrinsicFactor::EvaluateAt(const RectifiedStereo& stereo, const Eigen::Vector3d& z_px, double sigma_px,
+                                       double const* const* parameters, double* residuals, double** jacobians,
+                                       bool on_tangents) {
   const Eigen::Map<const Eigen::Matrix<double, 6, 1>> correction(parameters[2]);
-  const CorrectedRig& corrected = CorrectedRigOf(stereo_, correction);
+  const CorrectedRig& corrected = CorrectedRigOf(stereo, correction);
   const RectifiedStereo& rig = corrected.rig;
-  const StereoFactor stereo(z_px_, rig, sigma_px_);
   const bool want_extrinsic = jacobians != nullptr && jacobians[2] != nullptr;
   // The landmark Jacobian J_l = -(1/sigma) dh/dp_c R_c_w gives -(1/sigma) dh/dp_c = J_l R_w_c.
   Eigen::Matrix<double, 3, 3, Eigen::RowMajor> landmark_jacobian;
@@ -79,8 +85,7 @@ bool StereoExtrinsicFactor::EvaluateImpl(double const* const* parameters, double
     if (stereo_jacobians[1] == nullptr && want_extrinsic) stereo_jacobians[1] = landmark_jacobian.data();
   }
   double** inner = jacobians != nullptr ? stereo_jacobians : nullptr;
-  const bool ok = on_tangents ? stereo.EvaluateOnTangents(parameters, residuals, inner)
-                              : stereo.Evaluate(parameters, residuals, inner);
+  const bool ok = StereoFactor::EvaluateAt(rig, z_px, 1.0 / sigma_px, parameters, residuals, inner, on_tangents);
   if (!ok || !want_extrinsic) return ok;
   if (jacobians[1] != nullptr) landmark_jacobian = Eigen::Map<const decltype(landmark_jacobian)>(jacobians[1]);
   const Eigen::Quaterniond q_w_b(parameters[0][6], parameters[0][3], parameters[0][4], parameters[0][5]);

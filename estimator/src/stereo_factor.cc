@@ -2,6 +2,7 @@
 
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "vio/estimator/pose_manifold.h"
 #include "vio/estimator/so3.h"
@@ -45,15 +46,24 @@ Eigen::Matrix3d ProjectionJacobian(const RectifiedStereo& stereo, const Eigen::V
 
 }  // namespace
 
-StereoFactor::StereoFactor(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo,
+StereoFactor::StereoFactor(const Eigen::Vector3d& z_px, std::shared_ptr<const RectifiedStereo> stereo,
                            double sigma_px)
-    : z_px_(z_px), stereo_(stereo), inverse_sigma_(0.0) {
+    : z_px_(z_px), stereo_(std::move(stereo)), inverse_sigma_(0.0) {
+  if (stereo_ == nullptr) throw std::invalid_argument("StereoFactor: the rig (stereo) is null");
   if (!(sigma_px > 0.0)) {
     std::ostringstream message;
     message << "StereoFactor: sigma_px must be > 0, got " << sigma_px;
     throw std::invalid_argument(message.str());
   }
   inverse_sigma_ = 1.0 / sigma_px;
+}
+
+StereoFactor::StereoFactor(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo, double sigma_px)
+    : StereoFactor(z_px, std::make_shared<const RectifiedStereo>(stereo), sigma_px) {}
+
+ceres::CostFunction* StereoFactor::Create(const Eigen::Vector3d& z_px,
+                                          std::shared_ptr<const RectifiedStereo> stereo, double sigma_px) {
+  return new StereoFactor(z_px, std::move(stereo), sigma_px);
 }
 
 ceres::CostFunction* StereoFactor::Create(const Eigen::Vector3d& z_px,
@@ -72,30 +82,31 @@ bool StereoFactor::Project(const RectifiedStereo& stereo, const Eigen::Vector3d&
 
 bool StereoFactor::Evaluate(double const* const* parameters, double* residuals,
                             double** jacobians) const {
-  return EvaluateImpl(parameters, residuals, jacobians, /*on_tangents=*/false);
+  return EvaluateAt(*stereo_, z_px_, inverse_sigma_, parameters, residuals, jacobians, /*on_tangents=*/false);
 }
 
 bool StereoFactor::EvaluateOnTangents(double const* const* parameters, double* residuals,
                                       double** jacobians) const {
-  return EvaluateImpl(parameters, residuals, jacobians, /*on_tangents=*/true);
+  return EvaluateAt(*stereo_, z_px_, inverse_sigma_, parameters, residuals, jacobians, /*on_tangents=*/true);
 }
 
-bool StereoFactor::EvaluateImpl(double const* const* parameters, double* residuals, double** jacobians,
-                                bool on_tangents) const {
+bool StereoFactor::EvaluateAt(const RectifiedStereo& stereo, const Eigen::Vector3d& z_px, double inverse_sigma,
+                              double const* const* parameters, double* residuals, double** jacobians,
+                              bool on_tangents) {
   const Eigen::Map<const Eigen::Vector3d> p_w_b(parameters[0]);
   const Eigen::Quaterniond q_w_b =
       Eigen::Map<const Eigen::Quaterniond>(parameters[0] + 3).normalized();
   const Eigen::Map<const Eigen::Vector3d> p_w_l(parameters[1]);
   const Eigen::Matrix3d R_w_b = q_w_b.toRotationMatrix();
 
-  const CameraPoint point = ToCamera(stereo_, p_w_b, R_w_b, p_w_l);
+  const CameraPoint point = ToCamera(stereo, p_w_b, R_w_b, p_w_l);
   if (point.p_c.z() < kMinDepth) return false;
   Eigen::Map<Eigen::Vector3d>{residuals} =
-      inverse_sigma_ * (z_px_ - ProjectCameraPoint(stereo_, point.p_c));
+      inverse_sigma * (z_px - ProjectCameraPoint(stereo, point.p_c));
   if (jacobians == nullptr) return true;
 
   // d e / d p_c, then chained into the blocks.
-  const Eigen::Matrix3d de_dp_c = -inverse_sigma_ * ProjectionJacobian(stereo_, point.p_c);
+  const Eigen::Matrix3d de_dp_c = -inverse_sigma * ProjectionJacobian(stereo, point.p_c);
   const Eigen::Matrix3d R_c_w = point.R_c_b * R_w_b.transpose();
   if (jacobians[0] != nullptr) {
     Eigen::Matrix<double, 3, 6> J_tangent;

@@ -66,11 +66,13 @@ void State::SetSpeedBias(const Eigen::Vector3d& v_w_b, const Eigen::Vector3d& b_
   sb << v_w_b, b_g, b_a;
 }
 
-Window::Window(const ModelOptions& model, const RectifiedStereo& stereo)
-    : model_(model), stereo_(stereo), pose_manifold_(std::make_unique<PoseManifold>()) {
+Window::Window(const ModelOptions& model, const RectifiedStereo& stereo, ResidualIndex index)
+    : model_(model),
+      stereo_(std::make_shared<const RectifiedStereo>(stereo)),
+      pose_manifold_(std::make_unique<PoseManifold>()) {
   if (model_.huber_px > 0) loss_ = std::make_unique<ceres::HuberLoss>(model_.huber_px);
   ceres::Problem::Options options;
-  options.enable_fast_removal = true;
+  options.enable_fast_removal = index == ResidualIndex::kPerBlock;
   options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_ = std::make_unique<ceres::Problem>(options);
@@ -484,8 +486,10 @@ double Window::WhitenedError(StateId state_id, LandmarkId landmark_id, const Eig
   const Landmark& l = landmark(landmark_id);
   double residual[3];
   const double* params[2] = {s.pose, l.p_w};
-  std::unique_ptr<ceres::CostFunction> f(StereoFactor::Create(z_px, estimated_stereo(), model_.pixel_sigma));
-  if (!f->Evaluate(params, residual, nullptr)) return std::numeric_limits<double>::infinity();
+  if (!StereoFactor::EvaluateAt(estimated_stereo(), z_px, 1.0 / model_.pixel_sigma, params, residual, nullptr,
+                                /*on_tangents=*/false)) {
+    return std::numeric_limits<double>::infinity();
+  }
   const double error = Eigen::Map<Eigen::Vector3d>(residual).norm();
   return std::isfinite(error) ? error : std::numeric_limits<double>::infinity();
 }

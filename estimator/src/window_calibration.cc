@@ -61,7 +61,7 @@ std::vector<double*> Window::CalibrationBlocks() const {
 }
 
 RectifiedStereo Window::estimated_stereo() const {
-  return estimates_extrinsics() ? CorrectedStereo(stereo_, extrinsic_correction()) : stereo_;
+  return estimates_extrinsics() ? CorrectedStereo(*stereo_, extrinsic_correction()) : *stereo_;
 }
 
 void Window::SetTimeOffset(double s) {

@@ -1,5 +1,6 @@
 #include "vio/estimator/stereo_factor.h"
 
+#include <memory>
 #include <random>
 #include <stdexcept>
 
@@ -89,6 +90,35 @@ TEST(StereoFactor, RejectsLandmarksBehindTheCamera) {
   EXPECT_FALSE(StereoFactor::Project(stereo, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(),
                                      Eigen::Vector3d(-3.0, 0.0, 0.0), &z));
   EXPECT_EQ(z, Eigen::Vector3d::Constant(-1.0));
+}
+
+// Factors made with one shared rig hold it without a copy of their own (a window's factors), and
+// evaluate to the last bit as a factor with its own copy does.
+TEST(StereoFactor, FactorsShareOneRigAndEvaluateAsWithACopy) {
+  const auto rig = std::make_shared<const RectifiedStereo>(ForwardLookingStereo());
+  const Eigen::Vector3d z(300.0, 280.0, 200.0);
+  const StereoFactor first(z, rig, 0.8);
+  const std::unique_ptr<ceres::CostFunction> second(StereoFactor::Create(z, rig, 0.8));
+  EXPECT_EQ(rig.use_count(), 3);
+  const StereoFactor copy(z, ForwardLookingStereo(), 0.8);
+  const std::vector<std::vector<double>> blocks = {PoseBlock(Eigen::Vector3d(-2.0, 0.1, 0.2), Eigen::Quaterniond(
+                                                                 Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ()))),
+                                                   {1.0, 0.3, -0.2}};
+  Eigen::Vector3d r_shared, r_copy;
+  Eigen::Matrix<double, 3, 7, Eigen::RowMajor> J_shared, J_copy;
+  Eigen::Matrix<double, 3, 3, Eigen::RowMajor> L_shared, L_copy;
+  double* jacobians_shared[2] = {J_shared.data(), L_shared.data()};
+  double* jacobians_copy[2] = {J_copy.data(), L_copy.data()};
+  ASSERT_TRUE(second->Evaluate(Pointers(blocks).data(), r_shared.data(), jacobians_shared));
+  ASSERT_TRUE(copy.Evaluate(Pointers(blocks).data(), r_copy.data(), jacobians_copy));
+  EXPECT_EQ(r_shared, r_copy);
+  EXPECT_EQ(J_shared, J_copy);
+  EXPECT_EQ(L_shared, L_copy);
+}
+
+TEST(StereoFactor, RejectsANullRig) {
+  EXPECT_THROW(StereoFactor(Eigen::Vector3d::Zero(), std::shared_ptr<const RectifiedStereo>(), 1.0),
+               std::invalid_argument);
 }
 
 TEST(StereoFactor, RejectsNonPositiveSigma) {

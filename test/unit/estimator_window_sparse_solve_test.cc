@@ -99,6 +99,26 @@ TEST(WindowSparseSolve, HoldsTheConstantBlocks) {
   EXPECT_GT((window.state(StateId(5)).p_w_b() - moved_before).norm(), 1e-5);
 }
 
+// Without the per-block residual sets (batch's window, the refinement's) a removal scans the
+// residuals: the same observation and landmark dropped, the solve reaches the same values to the last bit.
+TEST(WindowSparseSolve, WithoutTheResidualIndexRemovesAndSolvesToTheSameBits) {
+  const auto solved = [](ResidualIndex index) {
+    const ModelOptions model;
+    Window window(model, Flight().stereo(), index);
+    Flight().Build(window, model, kFirst, kFrames, kOffsetM);
+    const int residuals = window.num_residual_blocks();
+    const Landmark& seen = window.landmarks().begin()->second;
+    EXPECT_GT(seen.observed_from.size(), 2u);
+    window.DropObservation(*seen.observed_from.begin(), seen.id);
+    window.DropLandmark(window.landmarks().rbegin()->first);
+    EXPECT_LT(window.num_residual_blocks(), residuals - 1);
+    EXPECT_TRUE(window.SolveSparse(Tight("lm", "sparse_full")).usable);
+    return AllValues(window);
+  };
+  const std::vector<double> indexed = solved(ResidualIndex::kPerBlock);
+  EXPECT_EQ(solved(ResidualIndex::kNone), indexed);
+}
+
 // The refinement builds the whole problem from the logged measurements: from
 // other start values (some states predicted by the IMU) it reaches the minimum
 // that the same problem built directly reaches, to within where Ceres' gradient

@@ -26,6 +26,8 @@
 // with de_h/dx the reprojection's (dh/dp_c is invertible for b != 0). With
 // t_d = t_a the residual and Jacobians of the pose, landmark and c are the
 // reprojection's; without t_d the factor is StereoExtrinsicFactor to the last bit.
+#include <memory>
+
 #include <ceres/cost_function.h>
 
 #include <Eigen/Core>
@@ -45,7 +47,11 @@ class StereoCalibrationFactor final : public ceres::CostFunction, public margina
     CameraMotion motion;
     double applied_offset_s = 0;
   };
-  /// time_offset: null when t_d is no block; extrinsics: whether c is a block. sigma_px > 0.
+  /// time_offset: null when t_d is no block; extrinsics: whether c is a block. stereo: the rig,
+  /// shared (not null); sigma_px > 0.
+  StereoCalibrationFactor(const Eigen::Vector3d& z_px, std::shared_ptr<const RectifiedStereo> stereo, double sigma_px,
+                          const TimeOffset* time_offset, bool extrinsics);
+  /// As above with a copy of `stereo` of its own.
   StereoCalibrationFactor(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo, double sigma_px,
                           const TimeOffset* time_offset, bool extrinsics);
 
@@ -57,9 +63,8 @@ class StereoCalibrationFactor final : public ceres::CostFunction, public margina
   /// Adds the time offset's term to the reprojection's residual and Jacobians.
   void AddTimeOffset(double const* const* parameters, double* residuals, double** jacobians, bool on_tangents) const;
 
-  StereoFactor plain_;
-  StereoExtrinsicFactor extrinsic_;
-  RectifiedStereo stereo_;
+  Eigen::Vector3d z_px_;
+  std::shared_ptr<const RectifiedStereo> stereo_;
   double sigma_px_;
   bool has_time_offset_;
   bool has_extrinsics_;

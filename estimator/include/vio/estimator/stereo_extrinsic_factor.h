@@ -10,6 +10,8 @@
 //   dp_c/ddtheta = [p_c]x Jr(dtheta),   dp_c/ddp = -R_b_c'^T
 // and the pose and landmark Jacobians are StereoFactor's at the corrected rig.
 // With c = 0 the residual is StereoFactor's.
+#include <memory>
+
 #include <ceres/sized_cost_function.h>
 
 #include <Eigen/Core>
@@ -26,17 +28,23 @@ RectifiedStereo CorrectedStereo(const RectifiedStereo& stereo, const Eigen::Matr
 class StereoExtrinsicFactor final : public ceres::SizedCostFunction<3, 7, 3, 6>,
                                     public marginalization::TangentCostFunction {
  public:
-  /// z_px = (u_L, u_R, v) rectified [px]; stereo: the given rig; sigma_px > 0.
+  /// z_px = (u_L, u_R, v) rectified [px]; stereo: the given rig, shared (not null); sigma_px > 0.
+  StereoExtrinsicFactor(const Eigen::Vector3d& z_px, std::shared_ptr<const RectifiedStereo> stereo, double sigma_px);
+  /// As above with a copy of `stereo` of its own.
   StereoExtrinsicFactor(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo, double sigma_px);
+
+  /// The residual and Jacobians (ambient, or on the tangents) of a measurement z_px with noise
+  /// sigma_px at the given rig `stereo`: what Evaluate and EvaluateOnTangents compute.
+  static bool EvaluateAt(const RectifiedStereo& stereo, const Eigen::Vector3d& z_px, double sigma_px,
+                         double const* const* parameters, double* residuals, double** jacobians, bool on_tangents);
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
   bool EvaluateOnTangents(double const* const* parameters, double* residuals, double** jacobians) const override;
 
  private:
-  bool EvaluateImpl(double const* const* parameters, double* residuals, double** jacobians, bool on_tangents) const;
 
   Eigen::Vector3d z_px_;
-  RectifiedStereo stereo_;
+  std::shared_ptr<const RectifiedStereo> stereo_;
   double sigma_px_;
 };
 

@@ -13,7 +13,10 @@
 //   de/d. = -(1 / sigma_px) dh/dp_c dp_c/d.
 // Evaluate returns false (Ceres rejects the step) when the landmark depth z
 // is below kMinDepth. No robust loss inside: the caller adds a
-// ceres::LossFunction.
+// ceres::LossFunction. The rig is held by shared pointer: the factors of a
+// window share its one rig (a copy is 160 B, most of a factor).
+#include <memory>
+
 #include <ceres/sized_cost_function.h>
 
 #include <Eigen/Core>
@@ -29,11 +32,21 @@ class StereoFactor final : public ceres::SizedCostFunction<3, 7, 3>, public marg
   /// Smallest depth [m] in the left camera that Evaluate accepts.
   static constexpr double kMinDepth = 1e-3;
 
-  /// z_px = (u_L, u_R, v) rectified [px]; sigma_px > 0 isotropic noise [px].
+  /// z_px = (u_L, u_R, v) rectified [px]; stereo: the rig, shared (not null); sigma_px > 0
+  /// isotropic noise [px].
+  StereoFactor(const Eigen::Vector3d& z_px, std::shared_ptr<const RectifiedStereo> stereo, double sigma_px);
+  /// As above with a copy of `stereo` of its own.
   StereoFactor(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo, double sigma_px);
 
+  static ceres::CostFunction* Create(const Eigen::Vector3d& z_px, std::shared_ptr<const RectifiedStereo> stereo,
+                                     double sigma_px);
   static ceres::CostFunction* Create(const Eigen::Vector3d& z_px, const RectifiedStereo& stereo,
                                      double sigma_px);
+
+  /// The residual and Jacobians (ambient, or on the tangents) of a measurement z_px with noise
+  /// 1 / inverse_sigma at `stereo`: what Evaluate and EvaluateOnTangents compute.
+  static bool EvaluateAt(const RectifiedStereo& stereo, const Eigen::Vector3d& z_px, double inverse_sigma,
+                         double const* const* parameters, double* residuals, double** jacobians, bool on_tangents);
 
   /// h(T_w_b, p_w_l): predicted (u_L, u_R, v) [px]; false (and *z_px
   /// untouched) when the depth in the left camera is below kMinDepth.
@@ -47,11 +60,8 @@ class StereoFactor final : public ceres::SizedCostFunction<3, 7, 3>, public marg
                           double** jacobians) const override;
 
  private:
-  bool EvaluateImpl(double const* const* parameters, double* residuals, double** jacobians,
-                    bool on_tangents) const;
-
   Eigen::Vector3d z_px_;
-  RectifiedStereo stereo_;
+  std::shared_ptr<const RectifiedStereo> stereo_;
   double inverse_sigma_;
 };
 

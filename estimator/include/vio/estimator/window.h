@@ -107,9 +107,15 @@ struct WindowHealth {
   int stopped_solves = 0;     ///< solves ended early by SolveControl::stop (their iterate is not converged)
 };
 
+/// How the window's Ceres problem finds the residuals of a parameter block. kPerBlock: every
+/// block keeps the set of its residuals (Ceres' enable_fast_removal), so removing a state or
+/// landmark costs what it touches; about 130 B per observation. kNone: no sets; a removal scans
+/// every residual: for windows that keep everything and remove little (batch, the refinement).
+enum class ResidualIndex { kPerBlock, kNone };
+
 class Window {
  public:
-  Window(const ModelOptions& model, const RectifiedStereo& stereo);
+  Window(const ModelOptions& model, const RectifiedStereo& stereo, ResidualIndex index = ResidualIndex::kPerBlock);
   ~Window();
   Window(const Window&) = delete;
   Window& operator=(const Window&) = delete;
@@ -265,7 +271,7 @@ class Window {
   /// `landmark` from `state` at the current estimate [sigma]; +inf when the
   /// landmark is (nearly) at or behind the camera.
   double WhitenedError(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px) const;
-  const RectifiedStereo& stereo() const { return stereo_; }
+  const RectifiedStereo& stereo() const { return *stereo_; }
   int num_priors() const { return static_cast<int>(priors_.size()); }
   const WindowHealth& health() const { return health_; }
   ceres::Problem& problem() { return *problem_; }
@@ -380,7 +386,9 @@ class Window {
   BlockKey KeyOf(const double* block) const;
 
   ModelOptions model_;
-  RectifiedStereo stereo_;
+  /// The given rig, one object that every stereo factor of the window shares (immutable: the
+  /// estimated correction is a parameter block).
+  std::shared_ptr<const RectifiedStereo> stereo_;
   std::unique_ptr<ceres::Manifold> pose_manifold_;
   std::unique_ptr<ceres::LossFunction> loss_;
   std::unique_ptr<ceres::Problem> problem_;
