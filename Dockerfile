@@ -1,7 +1,8 @@
 # vio in a container, two stages on Debian 12 (bookworm):
 #   build    the -dev packages and Python's plotting packages (tools/install_deps.sh build plot),
 #            a Release build of `vio` alone, then tools/docker_runtime_files.sh collects what
-#            runs: `vio`, Python 3 with numpy and matplotlib, and the shared libraries they load
+#            runs: `vio`, OpenCV's image codecs (loaded by `vio` when first used), Python 3 with
+#            numpy and matplotlib, and the shared libraries they load
 #   runtime  the base image plus those files, config/ and tools/plot_sweep.py; `vio` is the
 #            entrypoint. No compiler, no headers, no build tree, no tests.
 #   docker build -t vio .          (another Debian 12 base image: --build-arg BASE=...)
@@ -22,6 +23,7 @@ RUN rm -rf /src/build \
  && install -D -s /build/bin/vio /usr/local/bin/vio
 RUN py=/usr/lib/python3/dist-packages \
  && /src/tools/docker_runtime_files.sh /runtime /base-libs.txt /usr/local/bin/vio /usr/bin/python3 \
+      /usr/lib/x86_64-linux-gnu/libopencv_imgcodecs.so.4?? \
       /usr/lib/python3.11 $py/numpy $py/matplotlib $py/mpl_toolkits $py/PIL $py/kiwisolver $py/dateutil \
       $py/pyparsing $py/packaging $py/cycler.py $py/six.py /usr/share/matplotlib /etc/matplotlibrc \
  && install -D -m 755 /src/tools/plot_sweep.py /runtime/usr/local/share/vio/plot_sweep.py \

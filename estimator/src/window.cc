@@ -75,6 +75,10 @@ Window::Window(const ModelOptions& model, const RectifiedStereo& stereo, Residua
   options.enable_fast_removal = index == ResidualIndex::kPerBlock;
   options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  // Ceres' per-residual checks (a sorted copy of the blocks for duplicates, block sizes, aliasing of a new
+  // block's memory) cannot fail here: every block is a State's, Landmark's or calibration's own array, added
+  // with its size once, and each factor takes distinct ones.
+  options.disable_all_safety_checks = true;
   problem_ = std::make_unique<ceres::Problem>(options);
   if (model_.fej) first_estimates_ = std::make_shared<FirstEstimates>();
 }

@@ -264,6 +264,9 @@ std::vector<MalformedRun> Cases() {
        true},
       {"observation 150 px off", FeatureMovedInBothCameras(150), kRun, "", 0, "status ok",
        "\"rejected_observations\": 1", true},
+      // A malformed features row is found when the run reaches it: the frames before it are written.
+      {"features row malformed late", FeatureU("12x"), kRun, "", 1, "features0/data.csv:",
+       "\"status\": \"failed\"", true},
       // Options out of range: named, with the valid range.
       {"window size 0", {}, kRun + "--window_size=0", "", 1, "--window_size: '0' is outside the valid range [1, inf)"},
       {"window size -1", {}, kRun + "--window_size=-1", "", 1, "--window_size: '-1' is outside the valid range"},

@@ -121,11 +121,10 @@ EurocDataset ReadEuroc(const std::string& root, const EurocReadOptions& options)
   const std::string features = folders.mav0 + "/features0/data.csv";
   if (options.read_features && fs::exists(features, ec)) {
     if (options.stream_features) {
+      // The header and the first timestamp's rows only: the run's stream checks the others as it reads them.
       FeatureCsvStream stream(features);
       std::vector<FeatureObservation> group;
-      bool any = false;
-      while (stream.Next(&group)) any = true;
-      if (any) dataset.features_file = features;
+      if (stream.Next(&group)) dataset.features_file = features;
     } else {
       dataset.features = ReadFeaturesCsv(features);
     }

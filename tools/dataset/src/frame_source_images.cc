@@ -178,7 +178,7 @@ class ImageFrameSource final : public FrameSource {
 
   void WriteDebugImage(Timestamp t_ns, const cv::Mat& left, const cv::Mat& right) {
     const std::string path = debug_dir_ + "/" + std::to_string(t_ns) + ".png";
-    if (!cv::imwrite(path, drawer_.Draw(left, right, frontend_->features()))) {
+    if (!ImageWrite(path, drawer_.Draw(left, right, frontend_->features()))) {
       throw std::runtime_error(path + ": cannot write the debug image");
     }
   }

@@ -212,11 +212,11 @@ cv::Mat ReadGreyImage(const std::string& path) {
   const bool png = bytes->size() >= sizeof(kPngSignature) &&
                    std::memcmp(bytes->data(), kPngSignature, sizeof(kPngSignature)) == 0;
   const std::optional<cv::Size> size = png ? PlainGreySize(*bytes) : std::nullopt;
-  if (!size) return cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (!size) return ImageRead(path, cv::IMREAD_GRAYSCALE);
   bool transparency = false;
   const std::optional<std::vector<unsigned char>> compressed = ImageData(*bytes, &transparency);
   if (!compressed) return cv::Mat();
-  if (transparency) return cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (transparency) return ImageRead(path, cv::IMREAD_GRAYSCALE);
   std::vector<unsigned char> scanlines;
   cv::Mat image(*size, CV_8UC1);
   const size_t scanline_bytes = static_cast<size_t>(size->height) * (static_cast<size_t>(size->width) + 1);

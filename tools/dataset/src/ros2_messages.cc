@@ -3,6 +3,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "vio/dataset/image_file.h"
+
 namespace vio::tools::ros2 {
 namespace {
 
@@ -142,7 +144,7 @@ cv::Mat DecodeGreyImage(const std::string& type, const std::uint8_t* data, size_
   const RawCompressed image = ReadRawCompressed(data, size);
   *stamp = image.stamp;
   const cv::Mat bytes(1, static_cast<int>(image.size), CV_8UC1, const_cast<std::uint8_t*>(image.data));
-  cv::Mat grey = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+  cv::Mat grey = ImageDecode(bytes, cv::IMREAD_GRAYSCALE);
   if (grey.empty()) throw Ros2MessageError("the compressed image (" + std::to_string(image.size) + " bytes) does not decode");
   return grey;
 }

@@ -13,6 +13,7 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 
+#include "vio/dataset/image_file.h"
 #include "vio/dataset/ros2_dataset.h"
 
 namespace vio::tools {
@@ -214,7 +215,7 @@ void WriteCameraMessages(rosbag::Bag& bag, const EurocDataset& dataset, int came
   const std::string folder = dataset.root + "/mav0/cam" + std::to_string(camera) + "/data/";
   std::uint32_t seq = 0;
   for (const CameraFrame& f : dataset.frames[camera]) {
-    const cv::Mat grey = cv::imread(folder + f.filename, cv::IMREAD_GRAYSCALE);
+    const cv::Mat grey = ImageRead(folder + f.filename, cv::IMREAD_GRAYSCALE);
     if (grey.empty()) throw DatasetError(folder + f.filename + ": cannot read the image");
     sensor_msgs::Image msg = ImageMessage(grey, f.t_ns, seq++);
     msg.header.frame_id = "cam" + std::to_string(camera);
@@ -331,7 +332,7 @@ void WriteAslFromBag(const EurocDataset& dataset, const std::string& root) {
     for (size_t k = 0; k < dataset.frames[camera].size(); ++k) {
       const std::string file = folder + dataset.frames[camera][k].filename;
       const cv::Mat image = ros2_images ? ros2_images->Read(camera, k) : ros2 ? ros2->Read(k) : ros1->Read(k);
-      if (!cv::imwrite(file, image)) throw DatasetError(file + ": cannot write the image");
+      if (!ImageWrite(file, image)) throw DatasetError(file + ": cannot write the image");
     }
   }
 }

@@ -22,6 +22,7 @@ bool ConsistentIfSwapped(const PixelPair& pair, const frontend::StereoRectifier&
 void AddStereoObservations(const std::map<std::int64_t, PixelPair>& rows,
                            const frontend::StereoRectifier& rectifier, double max_epipolar_px, StereoFrame* frame,
                            StereoFramesReport* report) {
+  frame->observations.reserve(frame->observations.size() + rows.size());
   for (const auto& [id, pair] : rows) {
     if (!pair.uv[1]) { ++report->left_only; continue; }
     if (!pair.uv[0]) { ++report->right_only; continue; }

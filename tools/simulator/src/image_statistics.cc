@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vio/dataset/euroc_dataset.h"
+#include "vio/dataset/image_file.h"
 #include "vio/frontend/stereo_frontend.h"
 
 namespace vio::tools {
@@ -36,7 +37,7 @@ std::vector<PairFiles> StereoPairs(const EurocDataset& dataset, int max_frames) 
 }
 
 cv::Mat ReadGrey(const std::string& path) {
-  cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  cv::Mat image = ImageRead(path, cv::IMREAD_GRAYSCALE);
   if (image.empty()) throw DatasetError(path + ": cannot read the image");
   return image;
 }

@@ -11,6 +11,7 @@
 #include <glog/logging.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "vio/dataset/image_file.h"
 #include "vio/dataset/scene_csv.h"
 
 namespace vio::tools {
@@ -274,7 +275,7 @@ void WriteImages(const Simulation& sim, const SimulatorOptions& options, const R
         image.setTo(cv::Scalar::all(kBlackoutGrey));
       }
       const std::string path = folder + "/" + sim.dataset.frames[k][i].filename;
-      if (!cv::imwrite(path, image, png)) throw std::runtime_error("simulator: cannot write image " + path);
+      if (!ImageWrite(path, image, png)) throw std::runtime_error("simulator: cannot write image " + path);
       if (progress) progress(static_cast<std::int64_t>(k * sim.frames.size() + i + 1), total);
     }
   }

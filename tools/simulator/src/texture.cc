@@ -10,6 +10,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "vio/dataset/image_file.h"
+
 namespace vio::tools {
 namespace {
 
@@ -102,7 +104,7 @@ ImageTextures LoadImageTextures(const ImageTextureOptions& options) {
     const std::size_t count = std::min<std::size_t>(files.size(), options.max_images_per_dir);
     std::size_t loaded = 0;
     for (std::size_t k = 0; k < count; ++k) {
-      const cv::Mat grey = cv::imread(files[k * files.size() / count].string(), cv::IMREAD_GRAYSCALE);
+      const cv::Mat grey = ImageRead(files[k * files.size() / count].string(), cv::IMREAD_GRAYSCALE);
       if (grey.empty()) continue;
       textures.pyramids.push_back(Pyramid(grey, options.crop));
       ++loaded;

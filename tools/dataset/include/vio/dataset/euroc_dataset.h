@@ -88,7 +88,7 @@ struct EurocDataset {
   std::shared_ptr<const Ros2ImageIndex> ros2_images;
   std::vector<GroundTruthState> groundtruth;
   std::vector<FeatureObservation> features;  ///< features0, sorted by (t, camera, id)
-  /// features0/data.csv when it was checked but not kept (EurocReadOptions::stream_features)
+  /// features0/data.csv when it has rows and is not kept (EurocReadOptions::stream_features)
   std::string features_file;
 };
 
@@ -101,8 +101,9 @@ struct EurocReadOptions {
   bool check_images = true;
   bool read_groundtruth = true;
   bool read_features = true;      ///< features0/data.csv when present
-  /// With read_features: features0 is checked row by row but not kept (`features`
-  /// stays empty, `features_file` names it when it has rows; FeatureCsvStream reads it).
+  /// With read_features: features0 is not kept (`features` stays empty,
+  /// `features_file` names it when it has rows); only its header and first
+  /// timestamp's rows are checked here, the rest by the FeatureCsvStream that reads it.
   bool stream_features = false;
 };
 
