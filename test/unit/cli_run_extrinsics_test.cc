@@ -35,9 +35,9 @@ std::string SyntheticDataset(double error_deg, double error_m) {
   return options.output_dir;
 }
 
-// `probe`: the extrinsics probe's default (else off: the rig held as written).
+// `probe_s`: the extrinsics probe's longest span (0: off, the rig held as written).
 RunResult RunWith(const std::string& dataset, const std::string& policy, bool estimate, std::string* output = nullptr,
-                  bool probe = false) {
+                  double probe_s = 0.0) {
   RunRequest request;
   request.dataset_dir = dataset;
   request.output_dir = test::MakeTempDir("run_extrinsics_" + policy);
@@ -45,7 +45,7 @@ RunResult RunWith(const std::string& dataset, const std::string& policy, bool es
   request.show_progress = false;
   request.config.estimator.policy.policy = policy;
   request.config.estimator.model.estimate_extrinsics = estimate;
-  request.config.estimator.model.extrinsics_probe_s = probe ? 30.0 : 0.0;
+  request.config.estimator.model.extrinsics_probe_s = probe_s;
   // The simulator's IMU noise is the datasheet's: the matching model (cli_run_time_offset_test).
   request.config.estimator.model.imu_noise_scale = 1.0;
   return RunDataset(request);
@@ -125,7 +125,7 @@ TEST_P(Extrinsics, CorrectsARigErrorAndLeavesACleanRigAsItWas) {
   const RunResult reference = RunWith(clean, policy, /*estimate=*/false, &reference_out);
   ASSERT_EQ(reference.status, "ok");
   EXPECT_FALSE(reference.calibration.extrinsics_probe.has_value());
-  const RunResult probed = RunWith(clean, policy, /*estimate=*/false, &clean_out, /*probe=*/true);
+  const RunResult probed = RunWith(clean, policy, /*estimate=*/false, &clean_out, /*probe_s=*/30.0);
   ASSERT_EQ(probed.status, "ok");
   ASSERT_TRUE(probed.calibration.extrinsics_probe.has_value());
   EXPECT_FALSE(probed.calibration.extrinsics_probe->applied);
@@ -135,7 +135,7 @@ TEST_P(Extrinsics, CorrectsARigErrorAndLeavesACleanRigAsItWas) {
 
   const std::string off = SyntheticDataset(2.0, 0.03);
   std::string out;
-  const RunResult run = RunWith(off, policy, /*estimate=*/false, &out, /*probe=*/true);
+  const RunResult run = RunWith(off, policy, /*estimate=*/false, &out, /*probe_s=*/30.0);
   ASSERT_EQ(run.status, "ok");
   ASSERT_TRUE(run.calibration.extrinsics_probe.has_value());
   EXPECT_TRUE(run.calibration.extrinsics_probe->applied);
