@@ -234,13 +234,13 @@ void ValidateRequest(const RunRequest& request) {
 }
 
 // How a pass ended: at the data's end (or a stop), at a search's request to start again, or at the
-// extrinsics probe's decision (nothing is written at either).
+// extrinsics probe's decision to correct the rig (nothing is written at either).
 enum class PassEnd { kFinished, kSearch, kProbe };
 
 // One pass over the dataset. `searches`: the searches' results of an earlier pass that ended at them
 // (this one runs with the rig they found), else empty and filled when this pass's searches ask to
-// start again. `probe` (null: none): undecided, it runs in this pass; decided, the rig it found is
-// this pass's when it applied it. `earlier_pass_s`: the earlier passes' processing time, counted in this one's.
+// start again. `probe` (null: none): undecided, it runs in lockstep with this pass's estimator;
+// decided, the rig it found is this pass's when it applied it. `earlier_pass_s`: the earlier passes' processing time, counted in this one's.
 RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset, InitSearches* searches,
                   ExtrinsicsProbe* probe, double earlier_pass_s, PassEnd* end) {
   RunRequest request = requested;
@@ -256,6 +256,7 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset, Init
   const RectifiedStereo rig =
       probe != nullptr && probe->applied() ? probe->rig() : TurnedRig(rectifier.rectified(), *searches);
   Estimator estimator(request.config.estimator, dataset.imu_calibration, rig);
+  if (probing) probe->Start(request.config.estimator, dataset.imu_calibration, rig);
   const bool refine = request.trajectory == "smoothed" && request.config.estimator.policy.policy != "batch";
   if (refine) estimator.KeepMeasurements();
   RunOutput output(request.output_dir);
@@ -278,9 +279,9 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset, Init
   if (EstimateFrames(request, dataset, *source, estimator, output, observations ? &*observations : nullptr,
                      probing ? probe : nullptr, progress, &result)) {
     *end = estimator.restart_requested() ? PassEnd::kSearch : PassEnd::kProbe;
-  } else if (probing && result.status != "interrupted") {  // the data ended (or the run stopped) first
-    probe->Finish(estimator);
-    *end = PassEnd::kProbe;
+  } else if (probing && probe->running() && result.status != "interrupted") {  // the data ended first
+    probe->Finish();
+    if (probe->applied()) *end = PassEnd::kProbe;
   }
   if (*end != PassEnd::kFinished) {
     progress.Stop();
@@ -335,7 +336,7 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset, Init
 }  // namespace
 
 // A search at initialization found the camera-IMU time offset or the rig's rotation beyond its prior,
-// or the extrinsics probe decided: the run starts again from the first frame (docs/calibration.md).
+// or the extrinsics probe found the rig off: the run starts again from the first frame (docs/calibration.md).
 // At most three passes: the searches' results and the probe's decision each end one once.
 RunResult RunDataset(const RunRequest& requested) {
   ValidateRunConfig(requested.config);
@@ -348,18 +349,13 @@ RunResult RunDataset(const RunRequest& requested) {
   RunRequest request = requested;  // with the searches' results once they asked to start again
   double elapsed_s = 0;
   for (;;) {
-    RunRequest pass = request;
-    if (probe && !probe->decided()) {
-      // The probe measures the rig with the sliding window whatever the run's policy: MSCKF's estimate
-      // of the translation was the worse (docs/calibration.md).
-      pass.config.estimator.model.estimate_extrinsics = true;
-      pass.config.estimator.policy.policy = "swf";
-    }
     PassEnd end = PassEnd::kFinished;
-    RunResult result = RunPass(pass, dataset, &searches, probe ? &*probe : nullptr, elapsed_s, &end);
+    RunResult result = RunPass(request, dataset, &searches, probe ? &*probe : nullptr, elapsed_s, &end);
     if (end == PassEnd::kFinished) return result;
     elapsed_s = result.processing_s;
     if (end == PassEnd::kSearch) request = AfterSearches(request, searches, !probe.has_value());
+    // A probe that gave up before the searches' restart probes the next pass again.
+    if (end == PassEnd::kSearch && probe) probe.emplace(request.config.estimator.model);
     // The probe's rig holds any turn the rig rotation search found before it.
     if (end == PassEnd::kProbe && probe->applied()) request.config.estimator.model.extrinsics_rotation_search = false;
   }

@@ -174,6 +174,7 @@ bool EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
           continue;
         }
         estimator.SetInitialState(*gt);
+        if (probe != nullptr) probe->SetInitialState(*gt);
       }
       const StereoFrame frame = source.Frame(k, estimator);
       if (observations != nullptr) observations->Add(frame);
@@ -188,6 +189,10 @@ bool EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
         break;
       }
       if (estimator.restart_requested()) return true;
+      // Both estimators take the front end's one output; a probe that decided is dropped (or ends the pass).
+      if (probe != nullptr && probe->running() && probe->Update(frame, dataset.imu, estimator) && probe->applied()) {
+        return true;
+      }
       if (!estimate.initialized) {
         ++result->health.frames_waiting_init;
         result->init.last_reason = estimator.waiting_reason();
@@ -202,7 +207,6 @@ bool EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
         break;
       }
       output.AddFrame(estimate);
-      if (probe != nullptr && probe->Update(t_ns, estimator)) return true;
       if (request.output_covariance) {
         if (const std::optional<StateCovariance> covariance = estimator.NewestCovariance()) {
           output.AddCovariance(*covariance);

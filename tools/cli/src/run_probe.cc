@@ -17,31 +17,73 @@ bool ProbesExtrinsics(const RunConfig& config) {
          estimator.local_map.local_map_keyframes == 0 && estimator.policy.policy != "batch";
 }
 
-bool ExtrinsicsProbe::Update(Timestamp t_ns, Estimator& estimator) {
+void ExtrinsicsProbe::Start(const EstimatorOptions& options, const ImuCalibration& imu, const RectifiedStereo& rig) {
+  EstimatorOptions probe = options;
+  // The sliding window whatever the run's policy: MSCKF's estimate of the translation was the worse
+  // (docs/calibration.md).
+  probe.policy.policy = "swf";
+  probe.model.estimate_extrinsics = true;
+  probe.model.time_offset_search_ms = 0;
+  probe.model.extrinsics_rotation_search = false;
+  estimator_ = std::make_unique<Estimator>(probe, imu, rig);
+  next_imu_ = 0;
+  frames_since_init_ = 0;
+  start_ns_ = next_check_ns_ = last_ns_ = -1;
+  report_.reset();
+}
+
+void ExtrinsicsProbe::SetInitialState(const InitialState& state) {
+  if (running()) estimator_->SetInitialState(state);
+}
+
+bool ExtrinsicsProbe::Process(const StereoFrame& frame, const std::vector<ImuSample>& imu) {
+  const Timestamp imu_t_ns = estimator_->ImuTimeOf(frame.t_ns);
+  while (next_imu_ < imu.size() && (next_imu_ == 0 || imu[next_imu_ - 1].t_ns < imu_t_ns)) {
+    estimator_->AddImu(imu[next_imu_++]);
+  }
+  if (start_ns_ >= 0 && ++frames_since_init_ % model_.extrinsics_probe_stride != 0) return false;
+  const FrameEstimate estimate = estimator_->ProcessFrame(frame);
+  if (!estimate.initialized) return false;
+  if (!estimate.p_w_b.allFinite() || !estimate.v_w_b.allFinite() || estimate.p_w_b.norm() > 1e4 ||
+      estimate.v_w_b.norm() > 100) {
+    throw std::runtime_error("its estimate diverged at t=" + std::to_string(NanosToSeconds(frame.t_ns)) + " s");
+  }
+  if (start_ns_ < 0) start_ns_ = next_check_ns_ = frame.t_ns;
+  last_ns_ = frame.t_ns;
+  return true;
+}
+
+bool ExtrinsicsProbe::Update(const StereoFrame& frame, const std::vector<ImuSample>& imu, const Estimator& run) {
   if (decided()) return true;
-  if (start_ns_ < 0) start_ns_ = next_check_ns_ = t_ns;
-  last_ns_ = t_ns;
-  if (estimator.searching() || t_ns < next_check_ns_) return false;
-  next_check_ns_ = t_ns + SecondsToNanos(kCheckS);
-  const std::optional<Eigen::Matrix<double, 6, 6>> covariance = estimator.ExtrinsicCovariance();
-  const bool time_up = t_ns - start_ns_ >= SecondsToNanos(model_.extrinsics_probe_s);
+  CHECK(running()) << "ExtrinsicsProbe::Update before Start";
+  try {
+    if (!Process(frame, imu)) return false;
+  } catch (const std::exception& e) {
+    LOG(WARNING) << "extrinsics probe: " << e.what() << "; the run goes on without it";
+    Decide(last_ns_, std::nullopt);
+    return true;
+  }
+  if (run.searching() || last_ns_ < next_check_ns_) return false;
+  next_check_ns_ = last_ns_ + SecondsToNanos(kCheckS);
+  const std::optional<Eigen::Matrix<double, 6, 6>> covariance = estimator_->ExtrinsicCovariance();
+  const bool time_up = last_ns_ - start_ns_ >= SecondsToNanos(model_.extrinsics_probe_s);
   const bool settled =
       covariance && LargestSigma(covariance->topLeftCorner<3, 3>()) < 0.5 * model_.extrinsics_probe_min_deg * M_PI / 180.0 &&
       LargestSigma(covariance->bottomRightCorner<3, 3>()) < 0.5 * model_.extrinsics_probe_min_m;
   if (!time_up && !settled) return false;
-  Decide(t_ns, estimator, covariance);
+  Decide(last_ns_, covariance);
   return true;
 }
 
-void ExtrinsicsProbe::Finish(Estimator& estimator) {
+void ExtrinsicsProbe::Finish() {
   if (decided()) return;
+  CHECK(running()) << "ExtrinsicsProbe::Finish before Start";
   // Never initialized: no window to ask.
-  Decide(last_ns_, estimator, start_ns_ < 0 ? std::nullopt : estimator.ExtrinsicCovariance());
+  Decide(last_ns_, start_ns_ < 0 ? std::nullopt : estimator_->ExtrinsicCovariance());
 }
 
-void ExtrinsicsProbe::Decide(Timestamp t_ns, Estimator& estimator,
-                             const std::optional<Eigen::Matrix<double, 6, 6>>& covariance) {
-  const Window& window = estimator.window();
+void ExtrinsicsProbe::Decide(Timestamp t_ns, const std::optional<Eigen::Matrix<double, 6, 6>>& covariance) {
+  const Window& window = estimator_->window();
   const Eigen::Matrix<double, 6, 1> c = window.extrinsic_correction();
   CalibrationReport::ExtrinsicsProbe report;
   report.duration_s = start_ns_ < 0 ? 0.0 : NanosToSeconds(t_ns - start_ns_);
@@ -72,9 +114,10 @@ void ExtrinsicsProbe::Decide(Timestamp t_ns, Estimator& estimator,
   } else {
     LOG(INFO) << what.str() << ": not significant (chi2 above " << kChi2 << " and at least extrinsics_probe_min_deg "
               << model_.extrinsics_probe_min_deg << " or extrinsics_probe_min_m " << model_.extrinsics_probe_min_m
-              << " to apply); starting again from the first frame with sensor.yaml's rig";
+              << " to apply); the run goes on with sensor.yaml's rig";
   }
   report_ = report;
+  estimator_.reset();
 }
 
 }  // namespace vio::tools
