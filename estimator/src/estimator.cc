@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <iomanip>
+#include <map>
 #include <sstream>
 
 #include <glog/logging.h>
@@ -342,6 +343,29 @@ std::vector<FrameEstimate> Estimator::LastEstimates() const {
   for (const State& s : policy_->StatesBehindWindow(window_)) last.push_back(EstimateOf(s));
   for (const auto& [id, s] : window_.states()) last.push_back(EstimateOf(s));
   return last;
+}
+
+std::vector<FrameEstimate> Estimator::Refine(RefinementReport* report) const {
+  std::vector<FrameEstimate> refined;
+  if (!log_ || log_->states.empty()) return refined;
+  std::map<Timestamp, FrameEstimate> last;
+  for (const FrameEstimate& e : LastEstimates()) last[e.t_ns] = e;
+  const StartValue start = [&last](const LoggedState& logged, State* s) {
+    const auto it = last.find(logged.t_ns);
+    if (it == last.end()) return false;
+    s->SetPose(it->second.p_w_b, it->second.q_w_b);
+    s->SetSpeedBias(it->second.v_w_b, it->second.gyro_bias, it->second.accel_bias);
+    return true;
+  };
+  LandmarkStarts landmarks = log_->landmarks;
+  for (const auto& [id, landmark] : window_.landmarks()) landmarks[id] = landmark.position();
+  // Every state and landmark of the run, nothing removed but the observations that do not evaluate at the start.
+  Window whole(options_.model, window_.estimated_stereo(), ResidualIndex::kNone);
+  whole.SetSolveControl(window_.solve_control());
+  *report = vio::Refine(*log_, start, landmarks, options_, whole);
+  if (!report->usable) return refined;
+  for (const auto& [id, s] : whole.states()) refined.push_back(EstimateOf(s));
+  return refined;
 }
 
 FrameEstimate Estimator::EstimateOfInitial(const InitialState& s) {

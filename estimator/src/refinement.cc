@@ -104,33 +104,6 @@ void AddLandmarks(const MeasurementLog& log, const LandmarkStarts& landmarks, co
 
 }  // namespace
 
-MeasurementLog Thinned(const MeasurementLog& log, int stride) {
-  CHECK_GE(stride, 1) << "Thinned: stride";
-  MeasurementLog thin;
-  thin.first_prior = log.first_prior;
-  thin.first_covariance = log.first_covariance;
-  thin.time_offset = log.time_offset;
-  thin.landmarks = log.landmarks;
-  std::optional<ImuPreintegration> since_kept;  // the IMU from the last kept state on
-  bool linked = true;                            // every state since the last kept one has its IMU factor
-  for (size_t i = 0; i < log.states.size(); ++i) {
-    const LoggedState& logged = log.states[i];
-    if (!logged.imu) {
-      linked = false;
-    } else if (since_kept) {
-      since_kept->Append(*logged.imu);
-    } else {
-      since_kept = logged.imu;
-    }
-    if (i % static_cast<size_t>(stride) != 0) continue;
-    thin.states.push_back(logged);
-    thin.states.back().imu = linked ? since_kept : std::nullopt;
-    since_kept.reset();
-    linked = true;
-  }
-  return thin;
-}
-
 SolveReport SolveWhole(Window& window, const EstimatorOptions& options) {
   SolverOptions solver = options.solver;
   solver.max_iterations = options.batch.batch_final_iterations;

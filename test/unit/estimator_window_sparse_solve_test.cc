@@ -119,33 +119,26 @@ TEST(WindowSparseSolve, WithoutTheResidualIndexRemovesAndSolvesToTheSameBits) {
   EXPECT_EQ(solved(ResidualIndex::kNone), indexed);
 }
 
-// The log of the flight's kFrames frames from kFirst: every observation, the IMU between frames and
-// a tight prior on the first state.
-MeasurementLog FlightLog() {
-  MeasurementLog log;
-  StatePrior prior;
-  prior.pose_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e-6;
-  prior.speed_bias_sigma << Eigen::Vector3d::Constant(0.1), Eigen::Vector3d::Constant(0.01),
-      Eigen::Vector3d::Constant(0.1);
-  log.first_prior = prior;
-  for (int k = 0; k < kFrames; ++k) {
-    const StereoFrame& frame = Flight().frames()[kFirst + k];
-    LoggedState logged{StateId(k), frame.t_ns, frame.observations, std::nullopt};
-    if (k > 0) logged.imu = Flight().ImuBetween(kFirst + k - 1);
-    log.states.push_back(logged);
-  }
-  return log;
-}
-
 // The refinement builds the whole problem from the logged measurements: from
 // other start values (some states predicted by the IMU) it reaches the minimum
 // that the same problem built directly reaches, to within where Ceres' gradient
 // tolerance (1e-10) stops the two.
 TEST(Refinement, SolvesTheLoggedFramesToTheDirectSolve) {
   EstimatorOptions options;
-  const MeasurementLog log = FlightLog();
+  MeasurementLog log;
+  StatePrior prior;
+  prior.pose_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e-6;
+  prior.speed_bias_sigma << Eigen::Vector3d::Constant(0.1), Eigen::Vector3d::Constant(0.01),
+      Eigen::Vector3d::Constant(0.1);
+  log.first_prior = prior;
   Window direct(options.model, Flight().stereo());
   Flight().Build(direct, options.model, kFirst, kFrames, kOffsetM);
+  for (int k = 0; k < kFrames; ++k) {
+    const StereoFrame& frame = Flight().frames()[kFirst + k];
+    LoggedState logged{StateId(k), frame.t_ns, frame.observations, std::nullopt};
+    if (k > 0) logged.imu = Flight().ImuBetween(kFirst + k - 1);
+    log.states.push_back(logged);
+  }
   const StartValue start = [&direct](const LoggedState& logged, State* s) {
     std::copy(direct.state(logged.id).pose, direct.state(logged.id).pose + 7, s->pose);
     std::copy(direct.state(logged.id).speed_bias, direct.state(logged.id).speed_bias + 9, s->speed_bias);
@@ -171,9 +164,20 @@ TEST(Refinement, SolvesTheLoggedFramesToTheDirectSolve) {
 // (the first prior is centred on the start), to 1e-8.
 TEST(Refinement, StartsTheLandmarksAtTheirLoggedEstimates) {
   EstimatorOptions options;
-  const MeasurementLog log = FlightLog();
+  MeasurementLog log;
+  StatePrior prior;
+  prior.pose_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e-6;
+  prior.speed_bias_sigma << Eigen::Vector3d::Constant(0.1), Eigen::Vector3d::Constant(0.01),
+      Eigen::Vector3d::Constant(0.1);
+  log.first_prior = prior;
   Window direct(options.model, Flight().stereo());
   Flight().Build(direct, options.model, kFirst, kFrames, kOffsetM);
+  for (int k = 0; k < kFrames; ++k) {
+    const StereoFrame& frame = Flight().frames()[kFirst + k];
+    LoggedState logged{StateId(k), frame.t_ns, frame.observations, std::nullopt};
+    if (k > 0) logged.imu = Flight().ImuBetween(kFirst + k - 1);
+    log.states.push_back(logged);
+  }
   const auto start_at = [](const std::map<StateId, State>& states) {
     return [states](const LoggedState& logged, State* s) {
       std::copy(states.at(logged.id).pose, states.at(logged.id).pose + 7, s->pose);
@@ -207,9 +211,20 @@ TEST(Refinement, StartsTheLandmarksAtTheirLoggedEstimates) {
 // whole solve before its first iteration; they are dropped and the rest refines.
 TEST(Refinement, DropsObservationsThatDoNotEvaluateAtTheStart) {
   EstimatorOptions options;
-  const MeasurementLog log = FlightLog();
+  MeasurementLog log;
+  StatePrior prior;
+  prior.pose_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e-6;
+  prior.speed_bias_sigma << Eigen::Vector3d::Constant(0.1), Eigen::Vector3d::Constant(0.01),
+      Eigen::Vector3d::Constant(0.1);
+  log.first_prior = prior;
   Window direct(options.model, Flight().stereo());
   Flight().Build(direct, options.model, kFirst, kFrames, kOffsetM);
+  for (int k = 0; k < kFrames; ++k) {
+    const StereoFrame& frame = Flight().frames()[kFirst + k];
+    LoggedState logged{StateId(k), frame.t_ns, frame.observations, std::nullopt};
+    if (k > 0) logged.imu = Flight().ImuBetween(kFirst + k - 1);
+    log.states.push_back(logged);
+  }
   const Eigen::Vector3d optical_axis = Flight().stereo().T_b_cl.linear() * Eigen::Vector3d::UnitZ();
   const Eigen::Quaterniond half_turn(Eigen::AngleAxisd(M_PI, optical_axis.unitOrthogonal()));
   const StartValue start = [&direct, &half_turn](const LoggedState& logged, State* s) {
@@ -225,43 +240,6 @@ TEST(Refinement, DropsObservationsThatDoNotEvaluateAtTheStart) {
   EXPECT_TRUE(report.usable);
   EXPECT_GT(report.iterations, 0);
   EXPECT_EQ(report.states, kFrames);
-}
-
-// Thinned keeps every k-th logged state with the IMU between kept states composed: the kept states'
-// preintegrations span the same time as the IMU preintegrated between them at once and reach the same
-// deltas; the other states' observations are left out, and the thinned log refines.
-TEST(Refinement, ThinsTheLogToEveryKthStateWithTheImuComposed) {
-  EstimatorOptions options;
-  const MeasurementLog log = FlightLog();
-  constexpr int kStride = 4;
-  const MeasurementLog thin = Thinned(log, kStride);
-  ASSERT_EQ(thin.states.size(), static_cast<size_t>((kFrames + kStride - 1) / kStride));
-  EXPECT_FALSE(thin.states[0].imu.has_value());
-  for (size_t i = 0; i < thin.states.size(); ++i) {
-    const int k = static_cast<int>(i) * kStride;
-    EXPECT_EQ(thin.states[i].id, StateId(k));
-    EXPECT_EQ(thin.states[i].observations.size(), log.states[static_cast<size_t>(k)].observations.size());
-    if (i == 0) continue;
-    ASSERT_TRUE(thin.states[i].imu.has_value());
-    const ImuPreintegration at_once =
-        PreintegrateBetween(Flight().sim().dataset.imu, log.states[static_cast<size_t>(k - kStride)].t_ns,
-                            thin.states[i].t_ns, ImuBias{}, Flight().sim().dataset.imu_calibration);
-    EXPECT_NEAR(thin.states[i].imu->delta_time_s(), at_once.delta_time_s(), 1e-12);
-    EXPECT_LT((thin.states[i].imu->deltas().delta_p - at_once.deltas().delta_p).norm(), 1e-9);
-    EXPECT_LT(thin.states[i].imu->deltas().delta_q.angularDistance(at_once.deltas().delta_q), 1e-9);
-  }
-  EXPECT_EQ(Thinned(log, 1).states.size(), log.states.size());
-  Window direct(options.model, Flight().stereo());
-  Flight().Build(direct, options.model, kFirst, kFrames, kOffsetM);
-  const StartValue start = [&direct](const LoggedState& logged, State* s) {
-    std::copy(direct.state(logged.id).pose, direct.state(logged.id).pose + 7, s->pose);
-    std::copy(direct.state(logged.id).speed_bias, direct.state(logged.id).speed_bias + 9, s->speed_bias);
-    return true;
-  };
-  Window whole(options.model, Flight().stereo());
-  const RefinementReport report = Refine(thin, start, {}, options, whole);
-  EXPECT_TRUE(report.usable);
-  EXPECT_EQ(report.states, static_cast<int>(thin.states.size()));
 }
 
 }  // namespace

@@ -239,7 +239,7 @@ enum class PassEnd { kFinished, kSearch, kProbe };
 
 // One pass over the dataset. `searches`: the searches' results of an earlier pass that ended at them
 // (this one runs with the rig they found), else empty and filled when this pass's searches ask to
-// start again. `probe` (null: none): undecided, it probes this pass's estimator's first seconds;
+// start again. `probe` (null: none): undecided, it runs in lockstep with this pass's estimator;
 // decided, the rig it found is this pass's when it applied it. `earlier_pass_s`: the earlier passes' processing time, counted in this one's.
 RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset, InitSearches* searches,
                   ExtrinsicsProbe* probe, double earlier_pass_s, PassEnd* end) {
@@ -256,9 +256,9 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset, Init
   const RectifiedStereo rig =
       probe != nullptr && probe->applied() ? probe->rig() : TurnedRig(rectifier.rectified(), *searches);
   Estimator estimator(request.config.estimator, dataset.imu_calibration, rig);
+  if (probing) probe->Start(request.config.estimator, dataset.imu_calibration, rig);
   const bool refine = request.trajectory == "smoothed" && request.config.estimator.policy.policy != "batch";
   if (refine) estimator.KeepMeasurements();
-  if (probing) probe->Start(estimator, refine);
   RunOutput output(request.output_dir);
   RunResult result;
   result.trajectory = request.trajectory;
@@ -280,7 +280,7 @@ RunResult RunPass(const RunRequest& requested, const EurocDataset& dataset, Init
                      probing ? probe : nullptr, progress, &result)) {
     *end = estimator.restart_requested() ? PassEnd::kSearch : PassEnd::kProbe;
   } else if (probing && probe->running() && result.status != "interrupted") {  // the data ended first
-    probe->Finish(estimator);
+    probe->Finish();
     if (probe->applied()) *end = PassEnd::kProbe;
   }
   if (*end != PassEnd::kFinished) {

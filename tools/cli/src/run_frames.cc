@@ -174,6 +174,7 @@ bool EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
           continue;
         }
         estimator.SetInitialState(*gt);
+        if (probe != nullptr) probe->SetInitialState(*gt);
       }
       const StereoFrame frame = source.Frame(k, estimator);
       if (observations != nullptr) observations->Add(frame);
@@ -188,8 +189,8 @@ bool EstimateFrames(const RunRequest& request, const EurocDataset& dataset, Fram
         break;
       }
       if (estimator.restart_requested()) return true;
-      // A probe that decided to correct the rig ends the pass.
-      if (probe != nullptr && probe->running() && probe->Update(estimate, estimator) && probe->applied()) {
+      // Both estimators take the front end's one output; a probe that decided is dropped (or ends the pass).
+      if (probe != nullptr && probe->running() && probe->Update(frame, dataset.imu, estimator) && probe->applied()) {
         return true;
       }
       if (!estimate.initialized) {

@@ -16,7 +16,7 @@ namespace vio::tools {
 /// Bad data mid-run ends the loop with a status; what was estimated is kept.
 /// `observations` (null: none written) receives every frame the estimator is given.
 /// A stop request ends it before the next frame, or (a solve cut short) drops the frame in hand.
-/// `probe` (null: none in this pass), while it runs, is given each frame's estimate (it may decide there).
+/// `probe` (null: none in this pass), while it runs, is given each frame after the estimator.
 /// Returns true when a search at initialization (time offset, rig rotation) found the rig beyond its
 /// prior or the probe applied a correction (the pass ends there).
 bool EstimateFrames(const RunRequest& request, const EurocDataset& dataset, FrameSource& source,

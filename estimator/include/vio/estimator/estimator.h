@@ -108,20 +108,11 @@ class Estimator {
   /// per-frame estimates are the filter's.
   std::vector<FrameEstimate> LastEstimates() const;
   /// Keeps every frame's measurements (observations after gating, IMU factors, the first prior) from
-  /// now on, for Refine and SolveExtrinsics: call before the first frame (once kept, again is nothing).
-  void KeepMeasurements() {
-    if (!log_) log_.emplace();
-  }
-  /// Stops keeping them and drops those kept.
-  void DropMeasurements() { log_.reset(); }
+  /// now on, for Refine: call before the first frame.
+  void KeepMeasurements() { log_.emplace(); }
   /// The offline refinement (refinement.h): every kept state, landmark and IMU factor solved together,
   /// started from LastEstimates() and each landmark's last online estimate. Nothing when no measurements were kept or the solve was unusable.
   std::vector<FrameEstimate> Refine(RefinementReport* report) const;
-  /// The extrinsics probe's solve (docs/calibration.md): Refine's problem over the measurements kept
-  /// so far, with every `stride`-th state (Thinned) and a correction of the rig as a state under the
-  /// model's extrinsics prior, started from LastEstimates(). Not run (report.ran false) when nothing
-  /// was kept; no covariance when the solve was unusable or its information singular.
-  ExtrinsicsSolve SolveExtrinsics(int stride) const;
 
   /// The body pose at t_ns predicted by the IMU from the newest state (for a
   /// front end's outlier rejection); nothing before initialization or when
@@ -242,8 +233,6 @@ class Estimator {
   int implausible_inits_ = 0;                   ///< dynamic initializations in a row that were implausible
   std::string input_problem_;
   std::optional<MeasurementLog> log_;  ///< with KeepMeasurements: every state's measurements
-  /// Refine's problem of `log` built in `whole` (an empty window) and solved, from LastEstimates().
-  RefinementReport RefineLog(const MeasurementLog& log, Window& whole) const;
 };
 
 }  // namespace vio

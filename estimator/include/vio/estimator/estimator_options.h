@@ -254,10 +254,10 @@ struct ModelOptions {
   double extrinsics_prior_sigma_m = 0.02;   ///< prior standard deviation of its translation, per axis [m]
   double time_offset_search_ms = 100.0;  ///< range of the coarse search at initialization, either side [ms]; 0: none
   bool extrinsics_rotation_search = true;  ///< the rig's rotation found from gyro against camera at initialization
-  double extrinsics_probe_s = 0.0;       ///< the extrinsics probe's span at the start [s]; 0: no probe
+  double extrinsics_probe_s = 0.0;       ///< longest probe of the extrinsics at the start [s]; 0: no probe
   double extrinsics_probe_min_deg = 0.5;  ///< smallest rotation correction the probe applies [deg]
   double extrinsics_probe_min_m = 0.01;   ///< smallest translation correction the probe applies [m]
-  int extrinsics_probe_stride = 10;       ///< the probe's solve keeps every this-many-th state [frames]
+  int extrinsics_probe_stride = 1;        ///< the probe's estimator takes every this-many-th frame [frames]
 
   template <class V>
   void Visit(V& v) {
@@ -305,12 +305,12 @@ struct ModelOptions {
       "a rotation beyond 2 extrinsics_prior_sigma_deg (and 3 of its own sigmas) starts the run again with sensor.yaml's "
       "cameras turned by it (docs/calibration.md)");
     v("extrinsics_probe_s", extrinsics_probe_s,
-      "without estimate_extrinsics: the run's estimator keeps what it is given until this much frame time after its "
-      "initialization (and its searches decided), then one solve of it (every extrinsics_probe_stride-th state) with "
-      "the extrinsics estimated: a correction significant against its covariance (chi-square, 6 dof, 0.1 %) and at "
-      "least extrinsics_probe_min_deg or extrinsics_probe_min_m starts the run again from the first frame with the "
-      "rig corrected, else the run goes on as without the probe (docs/calibration.md); 0: no probe; 30 is a good "
-      "probe [s]",
+      "without estimate_extrinsics: a second estimator (SWF, every extrinsics_probe_stride-th frame) runs beside the "
+      "run's from the first frame with the extrinsics estimated, until their sigmas are below half of "
+      "extrinsics_probe_min_deg / _m or this much frame time after its initialization has passed; a correction "
+      "significant against its covariance (chi-square, 6 dof, 0.1 %) and at least extrinsics_probe_min_deg or "
+      "extrinsics_probe_min_m starts the run again from the first frame with the rig corrected, else the probe is "
+      "dropped and the run is the one without it (docs/calibration.md); 0: no probe; 30 is a good probe [s]",
       Between(0, 1000));
     v("extrinsics_probe_min_deg", extrinsics_probe_min_deg,
       "the extrinsics probe applies a correction only when its rotation is at least this or its translation at least "
@@ -321,8 +321,8 @@ struct ModelOptions {
       "extrinsics_probe_min_deg [m]",
       Positive(10));
     v("extrinsics_probe_stride", extrinsics_probe_stride,
-      "the extrinsics probe's solve keeps every this-many-th state of what it probes (the IMU preintegrated across "
-      "the others, their observations left out): its cost falls with it, the correction's accuracy too [frames]",
+      "the extrinsics probe's estimator takes every this-many-th frame once initialized (the IMU preintegrated "
+      "across the others, the tracks kept): its cost falls with it, the correction's accuracy too [frames]",
       Between(1, 20));
   }
 };

@@ -82,18 +82,4 @@ using LandmarkStarts = std::map<LandmarkId, Eigen::Vector3d>;
 RefinementReport Refine(const MeasurementLog& log, const StartValue& start, const LandmarkStarts& landmarks,
                         const EstimatorOptions& options, Window& whole);
 
-/// `log` with every `stride`-th state kept (the first one's index 0): each kept state's IMU factor is
-/// the preintegrations since the last kept state appended (ImuPreintegration::Append), the other
-/// states' observations are left out. `stride` >= 1 (1: a copy).
-MeasurementLog Thinned(const MeasurementLog& log, int stride);
-
-/// The extrinsics probe's solve (Estimator::SolveExtrinsics): the refinement with a correction of the
-/// rig as a state.
-struct ExtrinsicsSolve {
-  RefinementReport report;
-  Eigen::Matrix<double, 6, 1> correction = Eigen::Matrix<double, 6, 1>::Zero();  ///< Window::extrinsic_correction
-  std::optional<Eigen::Matrix<double, 6, 6>> covariance;  ///< its marginal covariance; none when unusable
-  RectifiedStereo rig;                                    ///< the rig corrected by it
-};
-
 }  // namespace vio
