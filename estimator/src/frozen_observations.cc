@@ -119,8 +119,7 @@ Eigen::Matrix<double, 15, 1> Window::StateStep(StateId id) {
   State& s = state(id);
   std::vector<ceres::ResidualBlockId> residuals;
   for (const Prior& prior : priors_) {
-    const bool on_state = std::find(prior.blocks.begin(), prior.blocks.end(), s.pose) != prior.blocks.end() ||
-                          std::find(prior.blocks.begin(), prior.blocks.end(), s.speed_bias) != prior.blocks.end();
+    const bool on_state = std::any_of(prior.keys.begin(), prior.keys.end(), [id](const BlockKey& k) { return k.IsOf(id); });
     if (on_state) residuals.push_back(prior.residual);
   }
   if (const auto into = imu_edges_.find(id); into != imu_edges_.end()) residuals.push_back(into->second.residual);

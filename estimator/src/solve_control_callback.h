@@ -4,8 +4,10 @@
 // ends the solve at the iterate reached.
 
 #include <ceres/iteration_callback.h>
+#include <ceres/solver.h>
 
 #include "vio/estimator/solve_control.h"
+#include "vio/estimator/window.h"
 
 namespace vio {
 
@@ -22,6 +24,17 @@ class SolveControlCallback final : public ceres::IterationCallback {
     return ceres::SOLVER_TERMINATE_SUCCESSFULLY;  // keeps the iterate reached
   }
   bool stopped() const { return stopped_; }
+  /// What the solve that ran with this callback did, from its summary.
+  SolveReport ReportOf(const ceres::Solver::Summary& summary) const {
+    SolveReport report;
+    report.iterations = static_cast<int>(summary.iterations.size());
+    report.initial_cost = summary.initial_cost;
+    report.final_cost = summary.final_cost;
+    report.usable = summary.IsSolutionUsable();
+    report.converged = summary.termination_type == ceres::CONVERGENCE;
+    report.stopped = stopped_;
+    return report;
+  }
 
  private:
   const SolveControl& control_;

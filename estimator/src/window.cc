@@ -8,6 +8,7 @@
 
 #include <glog/logging.h>
 
+#include "keyed_residuals.h"
 #include "vio/estimator/imu_factor.h"
 #include "vio/estimator/pose_manifold.h"
 #include "vio/estimator/pose_prior_factor.h"
@@ -111,8 +112,6 @@ State& Window::AddState(StateId id, Timestamp t_ns) {
   problem_->AddParameterBlock(s.pose, kPoseSize, pose_manifold_.get());
   problem_->AddParameterBlock(s.speed_bias, kSpeedBiasSize);
   variable_states_.insert(id);
-  block_keys_[s.pose] = BlockKey::Pose(id);
-  block_keys_[s.speed_bias] = BlockKey::SpeedBias(id);
   return s;
 }
 
@@ -127,9 +126,9 @@ void Window::AddImuResidual(ImuEdge& edge) {
   State& a = state(edge.from);
   State& b = state(edge.to);
   const Eigen::Vector3d g_w(0, 0, -model_.gravity);
-  ceres::CostFunction* factor = WithFirstEstimates(
-      Wrap(ImuFactor::Create(edge.preintegration, g_w)),
-      {BlockKey::Pose(a.id), BlockKey::SpeedBias(a.id), BlockKey::Pose(b.id), BlockKey::SpeedBias(b.id)});
+  const auto keys = ImuKeys(a.id, b.id);
+  ceres::CostFunction* factor =
+      WithFirstEstimates(Wrap(ImuFactor::Create(edge.preintegration, g_w)), {keys.begin(), keys.end()});
   edge.residual = problem_->AddResidualBlock(factor, nullptr, a.pose, a.speed_bias, b.pose, b.speed_bias);
 }
 
@@ -141,12 +140,12 @@ void Window::AddStatePrior(StateId id, const StatePrior& prior) {
       covariance.solve(Eigen::Matrix<double, 6, 6>::Identity()));
   CHECK(information.info() == Eigen::Success) << "state prior information is not positive definite";
   const Eigen::Matrix<double, 6, 6> sqrt_information = information.matrixU();
-  HoldFirstEstimates({s.pose, s.speed_bias});
+  HoldFirstEstimates({BlockKey::Pose(id), BlockKey::SpeedBias(id)});
   Prior pose_prior{problem_->AddResidualBlock(
                        WithFirstEstimates(PosePriorFactor::Create(s.p_w_b(), s.q_w_b(), sqrt_information),
                                           {BlockKey::Pose(id)}),
                        nullptr, s.pose),
-                   {s.pose}};
+                   {BlockKey::Pose(id)}};
   const Eigen::Matrix<double, 9, 1> sigma = prior.speed_bias_sigma;
   Prior sb_prior{problem_->AddResidualBlock(
                      WithFirstEstimates(
@@ -154,7 +153,7 @@ void Window::AddStatePrior(StateId id, const StatePrior& prior) {
                                                       sigma.cwiseInverse().asDiagonal().toDenseMatrix()),
                          {BlockKey::SpeedBias(id)}),
                      nullptr, s.speed_bias),
-                 {s.speed_bias}};
+                 {BlockKey::SpeedBias(id)}};
   priors_.push_back(pose_prior);
   priors_.push_back(sb_prior);
 }
@@ -166,7 +165,6 @@ Landmark& Window::AddLandmark(LandmarkId id, const Eigen::Vector3d& p_w) {
   Eigen::Map<Eigen::Vector3d>(l.p_w) = p_w;
   problem_->AddParameterBlock(l.p_w, kLandmarkSize);
   variable_landmarks_.insert(id);
-  block_keys_[l.p_w] = BlockKey::Landmark(id);
   return l;
 }
 
@@ -185,8 +183,8 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
   keys.reserve(kMostBlocks);
   blocks.push_back(s.pose);
   blocks.push_back(it->second.p_w);
-  keys.push_back(BlockKey::Pose(state_id));
-  keys.push_back(BlockKey::Landmark(landmark_id));
+  const auto point = PointKeys(state_id, landmark_id);
+  keys.assign(point.begin(), point.end());
   for (const auto& [block, key] : KeyedCalibrationBlocks()) {
     blocks.push_back(block);
     keys.push_back(key);
@@ -197,20 +195,41 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
   it->second.observed_from.insert(state_id);
 }
 
+std::vector<BlockKey> Window::KeysOf(const std::vector<StateId>& state_ids,
+                                     const std::vector<LandmarkId>& landmark_ids) {
+  std::vector<BlockKey> keys;
+  keys.reserve(2 * state_ids.size() + landmark_ids.size());
+  for (StateId id : state_ids) {
+    keys.push_back(BlockKey::Pose(id));
+    keys.push_back(BlockKey::SpeedBias(id));
+  }
+  for (LandmarkId id : landmark_ids) keys.push_back(BlockKey::Landmark(id));
+  return keys;
+}
+
 std::vector<double*> Window::Blocks(const std::vector<StateId>& state_ids,
                                    const std::vector<LandmarkId>& landmark_ids) {
   std::vector<double*> blocks;
-  for (StateId id : state_ids) {
-    State& s = state(id);
-    blocks.push_back(s.pose);
-    blocks.push_back(s.speed_bias);
-  }
-  for (LandmarkId id : landmark_ids) {
-    auto it = landmarks_.find(id);
-    CHECK(it != landmarks_.end()) << "no landmark " << id.value << " in the window";
-    blocks.push_back(it->second.p_w);
-  }
+  for (const BlockKey& key : KeysOf(state_ids, landmark_ids)) blocks.push_back(BlockOf(key));
   return blocks;
+}
+
+double* Window::BlockOf(const BlockKey& key) const {
+  switch (key.kind) {
+    case BlockKey::Kind::kPose:
+      return const_cast<double*>(state(StateId(key.id)).pose);
+    case BlockKey::Kind::kSpeedBias:
+      return const_cast<double*>(state(StateId(key.id)).speed_bias);
+    case BlockKey::Kind::kLandmark:
+      return const_cast<double*>(landmark(LandmarkId(key.id)).p_w);
+    case BlockKey::Kind::kTimeOffset:
+      CHECK(estimates_time_offset()) << "the time offset is not estimated";
+      return const_cast<double*>(time_offset_);
+    case BlockKey::Kind::kExtrinsics:
+      CHECK(estimates_extrinsics()) << "the extrinsics are not estimated";
+      return const_cast<double*>(extrinsic_);
+  }
+  LOG(FATAL) << "a block key of no kind";
 }
 
 void Window::AddLinearFactor(const std::vector<StateId>& state_ids, const std::vector<LandmarkId>& landmark_ids,
@@ -224,7 +243,7 @@ void Window::AddLinearFactor(const std::vector<StateId>& state_ids, const std::v
   }
   auto factor = marginalization::MarginalizationPrior::Create(std::move(prior_blocks), jacobian, residual);
   const ceres::ResidualBlockId id = problem_->AddResidualBlock(Wrap(factor.release()), nullptr, blocks);
-  priors_.push_back(Prior{id, {blocks.begin(), blocks.end()}});
+  priors_.push_back(Prior{id, KeysOf(state_ids, landmark_ids)});
 }
 
 void Window::SetStateConstant(StateId id, bool constant) {
@@ -274,108 +293,24 @@ int Window::RefreshImuFactors(double gyro_bias_threshold, StateId first_to) {
   return refreshed;
 }
 
-void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vector<LandmarkId>& landmark_ids) {
-  std::vector<double*> blocks = Blocks(state_ids, landmark_ids);
-  if (blocks.empty()) return;
-  const Leaving leaving = LeavingOf(state_ids, landmark_ids);
-  marginalization::MarginalizationOptions options;
-  options.residual_order = ResidualOrderOf(leaving);
-  options.kept_order = StateColumnOrder();
-  if (marginal_system_ == nullptr) {
-    marginal_system_ = std::make_unique<marginalization::BlockSystem>(problem_.get(), marginalization::BlockLayout{});
-  }
-  options.system = marginal_system_.get();
-  // Rank-deficient priors come in runs: after one, no unpivoted attempt at the
-  // next square root (a whole factorization that would fail its pivot test).
-  if (last_prior_rank_deficient_) options.sqrt_method = marginalization::SqrtMethod::kPivotedCholeskyOnly;
-  if (first_estimates_) {
-    options.first_estimate = [this](const double* block) { return first_estimates_->Find(KeyOf(block)); };
-  }
-  ForgetResidualsOf(leaving);
-  const ceres::ResidualBlockId prior = MarginalizeEvaluable(blocks, std::move(options));
-  last_prior_rank_deficient_ = false;
-  if (prior != nullptr) {
-    std::vector<double*> kept;
-    problem_->GetParameterBlocksForResidualBlock(prior, &kept);
-    int tangent_dim = 0;
-    for (const double* block : kept) tangent_dim += problem_->ParameterBlockTangentSize(block);
-    last_prior_rank_deficient_ = problem_->GetCostFunctionForResidualBlock(prior)->num_residuals() < tangent_dim;
-    priors_.push_back(Prior{prior, {kept.begin(), kept.end()}});
-    HoldFirstEstimates(kept);
-  }
-  for (StateId id : state_ids) {
-    removals_.leaving_states.push_back(states_.at(id));
-    RemoveStateBookkeeping(id);
-  }
-  for (LandmarkId id : landmark_ids) {
-    removals_.leaving_landmarks.emplace_back(id, landmarks_.at(id).position());
-    RemoveLandmarkBookkeeping(id);
-  }
-  removals_.marginalized_states.insert(removals_.marginalized_states.end(), state_ids.begin(), state_ids.end());
-  removals_.marginalized_landmarks.insert(removals_.marginalized_landmarks.end(), landmark_ids.begin(),
-                                          landmark_ids.end());
-}
-
-Window::Leaving Window::LeavingOf(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks) {
-  const std::vector<double*> blocks = Blocks(states, landmarks);
-  return {{states.begin(), states.end()}, {landmarks.begin(), landmarks.end()}, {blocks.begin(), blocks.end()}};
-}
-
-// Drops the bookkeeping of every residual of what leaves; the residual blocks
-// themselves go with their parameter blocks.
-void Window::ForgetResidualsOf(const Leaving& leaving) {
-  for (const ObservationKey& key : ObservationKeysOf(leaving)) {
-    landmarks_.at(key.second).observed_from.erase(key.first);
-    observations_.erase(key);
-  }
-  for (const ObservationKey& key : AnchoredKeysOf(leaving)) {
-    landmarks_.at(key.second).anchored_to.erase(key.first);
-    anchored_points_.erase(key);
-  }
-  for (auto it = imu_edges_.begin(); it != imu_edges_.end();) {
-    it = Touches(it->first, it->second, leaving) ? imu_edges_.erase(it) : std::next(it);
-  }
-  for (auto it = priors_.begin(); it != priors_.end();) {
-    it = Touches(*it, leaving) ? priors_.erase(it) : std::next(it);
-  }
-}
-
-// The marginalization assembles every residual of `blocks` and fails (throws,
-// the problem untouched) when one does not evaluate finitely: only then are
-// those residuals looked for and dropped, and the marginalization retried.
-ceres::ResidualBlockId Window::MarginalizeEvaluable(const std::vector<double*>& blocks,
-                                                    marginalization::MarginalizationOptions options) {
-  try {
-    return marginalization::MarginalizeBlocks(problem_.get(), blocks, options);
-  } catch (const std::exception&) {  // a failure that no dropped residual explains throws again below
-  }
-  const std::set<ceres::ResidualBlockId> dropped = DropUnevaluableResiduals(blocks);
-  auto& order = options.residual_order;
-  order.erase(std::remove_if(order.begin(), order.end(), [&](ceres::ResidualBlockId id) { return dropped.count(id) > 0; }),
-              order.end());
-  return marginalization::MarginalizeBlocks(problem_.get(), blocks, options);
-}
-
 // A residual that does not evaluate at the current point (a landmark at or
 // behind a camera, a non-finite value) would make the whole marginalization
 // fail: it is dropped with a warning instead. Bookkeeping is already gone.
-std::set<ceres::ResidualBlockId> Window::DropUnevaluableResiduals(const std::vector<double*>& blocks) {
-  std::set<ceres::ResidualBlockId> checked;
-  std::set<ceres::ResidualBlockId> dropped;
-  for (double* block : blocks) {
-    std::vector<ceres::ResidualBlockId> residuals;
-    problem_->GetResidualBlocksForParameterBlock(block, &residuals);
-    for (ceres::ResidualBlockId id : residuals) {
-      if (!checked.insert(id).second || EvaluatesFinitely(*problem_, id)) continue;
-      LOG(WARNING) << "marginalization: dropped a residual of "
-                   << problem_->GetCostFunctionForResidualBlock(id)->num_residuals()
-                   << " rows that does not evaluate finitely at the current estimate";
-      problem_->RemoveResidualBlock(id);
-      dropped.insert(id);
-      ++health_.dropped_residuals;
+void Window::DropUnevaluableResiduals(KeyedResiduals* residuals) {
+  KeyedResiduals evaluable;
+  for (std::size_t k = 0; k < residuals->size(); ++k) {
+    const ceres::ResidualBlockId id = residuals->ids[k];
+    if (EvaluatesFinitely(*problem_, id)) {
+      evaluable.Add(id, residuals->begin(k), residuals->end(k));
+      continue;
     }
+    LOG(WARNING) << "marginalization: dropped a residual of "
+                 << problem_->GetCostFunctionForResidualBlock(id)->num_residuals()
+                 << " rows that does not evaluate finitely at the current estimate";
+    problem_->RemoveResidualBlock(id);
+    ++health_.dropped_residuals;
   }
-  return dropped;
+  *residuals = std::move(evaluable);
 }
 
 std::vector<Window::ObservationKey> Window::UnevaluableObservations() const {
@@ -393,26 +328,22 @@ int Window::DropUnevaluableObservations() {
 }
 
 void Window::DropOutlierObservations(const std::vector<ObservationKey>& observations) {
-  const std::set<const double*> held = BlocksInPriors();
+  const std::set<LandmarkId> held = LandmarksInPriors();
   for (const auto& [state_id, landmark_id] : observations) {
     DropObservation(state_id, landmark_id);
     ++health_.dropped_observations;
     const Landmark& l = landmarks_.at(landmark_id);
-    if (Unconstrained(l) && held.count(l.p_w) == 0) DropLandmark(landmark_id);
+    if (Unconstrained(l) && held.count(landmark_id) == 0) DropLandmark(landmark_id);
   }
 }
 
 void Window::RemoveStateBookkeeping(StateId id) {
-  const State& s = state(id);
-  block_keys_.erase(s.pose);
-  block_keys_.erase(s.speed_bias);
   variable_states_.erase(id);
   states_.erase(id);
   camera_timing_.erase(id);
 }
 
 void Window::RemoveLandmarkBookkeeping(LandmarkId id) {
-  block_keys_.erase(landmark(id).p_w);
   variable_landmarks_.erase(id);
   landmarks_.erase(id);
 }
@@ -436,13 +367,10 @@ void Window::DropLandmark(LandmarkId landmark_id) {
 }
 
 bool Window::IsInPrior(StateId id) const {
-  const State& s = state(id);
-  for (const Prior& prior : priors_) {
-    for (const double* block : prior.blocks) {
-      if (block == s.pose || block == s.speed_bias) return true;
-    }
-  }
-  return false;
+  CHECK(HasState(id)) << "no state " << id.value << " in the window";
+  const auto of_state = [id](const BlockKey& key) { return key.IsOf(id); };
+  return std::any_of(priors_.begin(), priors_.end(),
+                     [&](const Prior& prior) { return std::any_of(prior.keys.begin(), prior.keys.end(), of_state); });
 }
 
 void Window::DropState(StateId id) {

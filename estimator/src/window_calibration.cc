@@ -20,14 +20,14 @@ void Window::EstimateTimeOffset(double mean_s, double sigma_s) {
   CHECK(sigma_s > 0 && std::isfinite(mean_s)) << "time offset prior: sigma " << sigma_s << ", mean " << mean_s;
   time_offset_[0] = mean_s;
   problem_->AddParameterBlock(time_offset_, 1);
-  block_keys_[time_offset_] = BlockKey::TimeOffset();
   // N(mean, sigma^2) as a linear factor r = (t_d - mean) / sigma, kept with the priors.
   std::vector<marginalization::MarginalizationPrior::Block> block = {{nullptr, {mean_s}}};
   auto factor = marginalization::MarginalizationPrior::Create(
       std::move(block), Eigen::MatrixXd::Constant(1, 1, 1.0 / sigma_s), Eigen::VectorXd::Zero(1));
-  time_offset_prior_ = Prior{problem_->AddResidualBlock(factor.release(), nullptr, time_offset_), {time_offset_}};
+  time_offset_prior_ =
+      Prior{problem_->AddResidualBlock(factor.release(), nullptr, time_offset_), {BlockKey::TimeOffset()}};
   priors_.push_back(time_offset_prior_);
-  HoldFirstEstimates({time_offset_});
+  HoldFirstEstimates({BlockKey::TimeOffset()});
 }
 
 void Window::EstimateExtrinsics(double sigma_rad, double sigma_m) {
@@ -35,16 +35,15 @@ void Window::EstimateExtrinsics(double sigma_rad, double sigma_m) {
   CHECK(observations_.empty()) << "EstimateExtrinsics after observations were added";
   CHECK(sigma_rad > 0 && sigma_m > 0) << "extrinsics prior: sigmas " << sigma_rad << " rad, " << sigma_m << " m";
   problem_->AddParameterBlock(extrinsic_, 6);
-  block_keys_[extrinsic_] = BlockKey::Extrinsics();
   // N(0, diag(sigma_rad^2, sigma_m^2)) as a linear factor r = diag(1/sigma) c, kept with the priors.
   std::vector<marginalization::MarginalizationPrior::Block> block = {{nullptr, std::vector<double>(6, 0.0)}};
   Eigen::Matrix<double, 6, 1> information;
   information << Eigen::Vector3d::Constant(1.0 / sigma_rad), Eigen::Vector3d::Constant(1.0 / sigma_m);
   auto factor = marginalization::MarginalizationPrior::Create(std::move(block), information.asDiagonal().toDenseMatrix(),
                                                               Eigen::VectorXd::Zero(6));
-  extrinsic_prior_ = Prior{problem_->AddResidualBlock(factor.release(), nullptr, extrinsic_), {extrinsic_}};
+  extrinsic_prior_ = Prior{problem_->AddResidualBlock(factor.release(), nullptr, extrinsic_), {BlockKey::Extrinsics()}};
   priors_.push_back(extrinsic_prior_);
-  HoldFirstEstimates({extrinsic_});
+  HoldFirstEstimates({BlockKey::Extrinsics()});
 }
 
 std::vector<std::pair<double*, BlockKey>> Window::KeyedCalibrationBlocks() const {
@@ -58,6 +57,12 @@ std::vector<double*> Window::CalibrationBlocks() const {
   std::vector<double*> blocks;
   for (const auto& [block, key] : KeyedCalibrationBlocks()) blocks.push_back(block);
   return blocks;
+}
+
+std::vector<BlockKey> Window::CalibrationKeys() const {
+  std::vector<BlockKey> keys;
+  for (const auto& [block, key] : KeyedCalibrationBlocks()) keys.push_back(key);
+  return keys;
 }
 
 RectifiedStereo Window::estimated_stereo() const {

@@ -10,6 +10,7 @@
 
 #include "vio/estimator/window.h"
 
+#include "keyed_residuals.h"
 #include "vio/estimator/anchored_point_factor.h"
 
 namespace vio {
@@ -22,22 +23,22 @@ void Window::SetAnchoredPoint(StateId anchor, LandmarkId landmark_id, const Eige
   const ObservationKey key{anchor, landmark_id};
   auto existing = anchored_points_.find(key);
   if (existing != anchored_points_.end()) problem_->RemoveResidualBlock(existing->second);
-  anchored_points_[key] = problem_->AddResidualBlock(
-      WithFirstEstimates(Wrap(new AnchoredPointFactor(p_b_hat, sqrt_information)),
-                         {BlockKey::Pose(anchor), BlockKey::Landmark(landmark_id)}),
-      nullptr, s.pose, it->second.p_w);
+  const auto keys = PointKeys(anchor, landmark_id);
+  anchored_points_[key] =
+      problem_->AddResidualBlock(WithFirstEstimates(Wrap(new AnchoredPointFactor(p_b_hat, sqrt_information)),
+                                                    {keys.begin(), keys.end()}),
+                                 nullptr, s.pose, it->second.p_w);
   it->second.anchored_to.insert(anchor);
 }
 
 void Window::RemoveState(StateId id) {
   State& s = state(id);
   for (auto it = priors_.begin(); it != priors_.end();) {
-    const auto of_this = [&](const double* b) { return b == s.pose || b == s.speed_bias; };
-    const auto mine = std::count_if(it->blocks.begin(), it->blocks.end(), of_this);
-    const auto calibration = std::count(it->blocks.begin(), it->blocks.end(), time_offset_) +
-                             std::count(it->blocks.begin(), it->blocks.end(), extrinsic_);
+    const auto mine = std::count_if(it->keys.begin(), it->keys.end(), [id](const BlockKey& k) { return k.IsOf(id); });
+    const auto calibration =
+        std::count_if(it->keys.begin(), it->keys.end(), [](const BlockKey& k) { return k.IsCalibration(); });
     const bool touches = mine > 0;
-    CHECK(!touches || mine + calibration == static_cast<std::ptrdiff_t>(it->blocks.size()))
+    CHECK(!touches || mine + calibration == static_cast<std::ptrdiff_t>(it->keys.size()))
         << "state " << id.value << " shares a prior with other blocks";
     // The residual block goes with the state's parameter blocks below.
     it = touches ? priors_.erase(it) : std::next(it);

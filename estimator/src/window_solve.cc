@@ -14,6 +14,7 @@
 
 #include <glog/logging.h>
 
+#include "keyed_residuals.h"
 #include "solve_control_callback.h"
 #include "vio/estimator/window.h"
 
@@ -26,9 +27,13 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-std::set<const double*> Window::BlocksInPriors() const {
-  std::set<const double*> in_prior;
-  for (const Prior& prior : priors_) in_prior.insert(prior.blocks.begin(), prior.blocks.end());
+std::set<LandmarkId> Window::LandmarksInPriors() const {
+  std::set<LandmarkId> in_prior;
+  for (const Prior& prior : priors_) {
+    for (const BlockKey& key : prior.keys) {
+      if (key.kind == BlockKey::Kind::kLandmark) in_prior.insert(LandmarkId(key.id));
+    }
+  }
   return in_prior;
 }
 
@@ -70,25 +75,31 @@ std::set<Window::ObservationKey> Window::AnchoredKeysOf(const Leaving& leaving) 
 }
 
 bool Window::Touches(const Prior& prior, const Leaving& leaving) const {
-  return std::any_of(prior.blocks.begin(), prior.blocks.end(),
-                     [&](const double* block) { return leaving.blocks.count(block) > 0; });
+  return std::any_of(prior.keys.begin(), prior.keys.end(), [&](const BlockKey& key) { return leaving.Has(key); });
 }
 
 bool Window::Touches(StateId to, const ImuEdge& edge, const Leaving& leaving) const {
   return leaving.states.count(edge.from) > 0 || leaving.states.count(to) > 0;
 }
 
-std::vector<ceres::ResidualBlockId> Window::ResidualOrderOf(const Leaving& leaving) const {
-  std::vector<ceres::ResidualBlockId> order;
+KeyedResiduals Window::ResidualOrderOf(const Leaving& leaving) const {
+  KeyedResiduals order;
   for (const Prior& prior : priors_) {
-    if (Touches(prior, leaving)) order.push_back(prior.residual);
+    if (Touches(prior, leaving)) order.Add(prior.residual, prior.keys);
   }
   for (const auto& [to, edge] : imu_edges_) {
-    if (Touches(to, edge, leaving)) order.push_back(edge.residual);
+    if (Touches(to, edge, leaving)) order.Add(edge.residual, ImuKeys(edge.from, to));
   }
-  for (const ObservationKey& key : ObservationKeysOf(leaving)) order.push_back(observations_.at(key).residual);
-  for (const ObservationKey& key : AnchoredKeysOf(leaving)) order.push_back(anchored_points_.at(key));
+  const std::vector<BlockKey> calibration = CalibrationKeys();
+  for (const auto& [state, landmark] : ObservationKeysOf(leaving)) {
+    order.Add(observations_.at({state, landmark}).residual, PointKeys(state, landmark), calibration);
+  }
+  AddAnchoredPoints(AnchoredKeysOf(leaving), &order);
   return order;
+}
+
+void Window::AddAnchoredPoints(const std::set<ObservationKey>& keys, KeyedResiduals* order) const {
+  for (const auto& [state, landmark] : keys) order->Add(anchored_points_.at({state, landmark}), PointKeys(state, landmark));
 }
 
 // Dense columns: every pose, the time offset, then every speed/bias block (both by state id),
@@ -97,7 +108,7 @@ std::vector<ceres::ResidualBlockId> Window::ResidualOrderOf(const Leaving& leavi
 // seeing a landmark are one contiguous range of columns (a track is seen from
 // consecutive states), so its Schur update is one rank-3 update in place.
 GaussNewtonLayout Window::Layout() const {
-  const std::set<const double*> in_prior = BlocksInPriors();
+  const std::set<LandmarkId> in_prior = LandmarksInPriors();
   GaussNewtonLayout layout;
   layout.residuals = ResidualOrder();
   const auto variable = [this](const double* block) { return !problem_->IsParameterBlockConstant(block); };
@@ -116,19 +127,10 @@ GaussNewtonLayout Window::Layout() const {
   }
   for (const auto& [id, landmark] : landmarks_) {
     if (!variable(landmark.p_w)) continue;
-    auto& group = in_prior.count(landmark.p_w) ? layout.dense : layout.eliminated;
+    auto& group = in_prior.count(id) ? layout.dense : layout.eliminated;
     group.push_back(const_cast<double*>(landmark.p_w));
   }
   return layout;
-}
-
-std::vector<const double*> Window::StateColumnOrder() const {
-  std::vector<const double*> order;
-  order.reserve(2 * states_.size() + 1);
-  for (const auto& [id, s] : states_) order.push_back(s.speed_bias);
-  for (const auto& [id, s] : states_) order.push_back(s.pose);
-  if (estimates_time_offset()) order.push_back(time_offset_);
-  return order;
 }
 
 // Landmarks (group 0) are eliminated first by the Schur complement; the
@@ -137,7 +139,7 @@ std::vector<const double*> Window::StateColumnOrder() const {
 // last digits (gn does not: Layout() is by id). Landmarks tied together by a
 // prior are not an independent set: they join the states, after them.
 std::shared_ptr<ceres::ParameterBlockOrdering> Window::SchurOrdering() const {
-  const std::set<const double*> in_prior = BlocksInPriors();
+  const std::set<LandmarkId> in_prior = LandmarksInPriors();
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   int group = 1;
   for (const auto& [id, s] : states_) {
@@ -146,7 +148,7 @@ std::shared_ptr<ceres::ParameterBlockOrdering> Window::SchurOrdering() const {
   }
   for (double* block : CalibrationBlocks()) ordering->AddElementToGroup(block, group++);
   for (const auto& [id, landmark] : landmarks_) {
-    const bool eliminated = in_prior.count(landmark.p_w) == 0;
+    const bool eliminated = in_prior.count(id) == 0;
     ordering->AddElementToGroup(const_cast<double*>(landmark.p_w), eliminated ? 0 : group++);
   }
   return ordering;
@@ -294,13 +296,7 @@ SolveReport Window::LevenbergMarquardt(const ceres::Solver::Options& base, const
   solver.callbacks.push_back(&control);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, problem_.get(), &summary);
-  SolveReport report;
-  report.iterations = static_cast<int>(summary.iterations.size());
-  report.initial_cost = summary.initial_cost;
-  report.final_cost = summary.final_cost;
-  report.usable = summary.IsSolutionUsable();
-  report.converged = summary.termination_type == ceres::CONVERGENCE;
-  report.stopped = control.stopped();
+  const SolveReport report = control.ReportOf(summary);
   if (report.stopped) ++health_.stopped_solves;
   if (!report.usable) ++health_.failed_solves;
   return report;

@@ -14,10 +14,13 @@
 #include <string>
 #include <tuple>
 #include <unordered_map>
+#include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include <glog/logging.h>
 
+#include "keyed_residuals.h"
 #include "quadratic_landmark_factor.h"
 #include "solve_control_callback.h"
 #include "vio/estimator/window.h"
@@ -83,27 +86,61 @@ CopyRank RankOf(const BlockKey& key) {
 
 }  // namespace
 
-// The window's blocks a set of residuals touches, copied into one buffer in
-// id order; `copy_of` maps a window block to its copy (a lookup only: the
-// order is `blocks`').
-struct Window::IdOrderedCopy {
+// The blocks of a copy, in id order (RankOf), their values in one buffer.
+struct IdOrderedCopy {
   std::vector<double> values;
-  std::vector<const double*> blocks;  ///< window blocks, in copy order
-  std::unordered_map<const double*, double*> copy_of;
+  std::vector<BlockKey> keys;
+  std::vector<double*> window_blocks;  ///< the window's block of each key
+  std::vector<std::size_t> offsets;    ///< where each block starts in `values`
+  std::unordered_map<BlockKey, std::size_t, BlockKeyHash> place;  ///< a key's place in `keys` (a lookup only)
+
+  double* Of(const BlockKey& key) { return values.data() + offsets[place.at(key)]; }
 };
+
+namespace {
+
+// Adds the copy's blocks to `copy` (constant where the window's are), in their order and elimination groups.
+std::shared_ptr<ceres::ParameterBlockOrdering> AddBlocks(const ceres::Problem& window, IdOrderedCopy& ids,
+                                                          const std::vector<int>& groups, ceres::Problem* copy) {
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (std::size_t k = 0; k < ids.keys.size(); ++k) {
+    const double* block = ids.window_blocks[k];
+    double* c = ids.values.data() + ids.offsets[k];
+    copy->AddParameterBlock(c, window.ParameterBlockSize(block), const_cast<ceres::Manifold*>(window.GetManifold(block)));
+    const bool constant = window.IsParameterBlockConstant(block);
+    if (constant) copy->SetParameterBlockConstant(c);
+    ordering->AddElementToGroup(c, constant ? 1 : groups[k]);
+  }
+  return ordering;
+}
+
+// Adds each residual, on the copy's blocks of its keys, and each of `extra`, to `copy`.
+void AddResiduals(const ceres::Problem& window, const KeyedResiduals& residuals,
+                  const std::vector<std::pair<LandmarkId, ceres::CostFunction*>>& extra, IdOrderedCopy& ids,
+                  ceres::Problem* copy) {
+  std::vector<double*> blocks;
+  for (std::size_t k = 0; k < residuals.size(); ++k) {
+    blocks.clear();
+    for (const BlockKey* key = residuals.begin(k); key != residuals.end(k); ++key) blocks.push_back(ids.Of(*key));
+    const ceres::ResidualBlockId id = residuals.ids[k];
+    copy->AddResidualBlock(const_cast<ceres::CostFunction*>(window.GetCostFunctionForResidualBlock(id)),
+                           const_cast<ceres::LossFunction*>(window.GetLossFunctionForResidualBlock(id)), blocks);
+  }
+  for (const auto& [landmark, factor] : extra) copy->AddResidualBlock(factor, nullptr, ids.Of(BlockKey::Landmark(landmark)));
+}
+
+}  // namespace
 
 SolveReport Window::SolveSparse(const SolverOptions& options) {
   const VariableIds variable = VariableIdsOf();
   if (variable.states.empty() && variable.landmarks.empty()) return SolveReport();
-  const Leaving solved = SolvedOf(variable);
-  const std::vector<ceres::ResidualBlockId> residuals = ResidualOrderOf(solved);
-  return SolveCopy(options, residuals, {}, CopyOf(residuals, {}));
+  return SolveCopy(options, ResidualOrderOf(SolvedOf(variable)), {});
 }
 
 Window::Leaving Window::SolvedOf(const VariableIds& variable) {
   Leaving solved = LeavingOf(variable.states, variable.landmarks);
-  for (double* block : CalibrationBlocks()) {
-    if (!problem_->IsParameterBlockConstant(block)) solved.blocks.insert(block);  // and its prior
+  for (const auto& [block, key] : KeyedCalibrationBlocks()) {
+    if (!problem_->IsParameterBlockConstant(block)) solved.calibration.insert(key);  // and its prior
   }
   return solved;
 }
@@ -113,32 +150,19 @@ Window::VariableIds Window::VariableIdsOf() const {
 }
 
 // Every block the residuals and `extra` touch, states (pose, speed/bias) then landmarks, by id.
-Window::IdOrderedCopy Window::CopyOf(const std::vector<ceres::ResidualBlockId>& residuals,
-                                     const LandmarkFactors& extra) const {
-  std::unordered_map<const double*, CopyRank> touched;
-  const auto touch = [&](const double* block) {
-    const auto key = block_keys_.find(block);
-    CHECK(key != block_keys_.end()) << "a residual touches a block that is no state, landmark or calibration";
-    touched.emplace(block, RankOf(key->second));
-  };
-  for (ceres::ResidualBlockId residual : residuals) {
-    std::vector<double*> blocks;
-    problem_->GetParameterBlocksForResidualBlock(residual, &blocks);
-    for (const double* block : blocks) touch(block);
-  }
-  for (const auto& [block, factor] : extra) touch(block);
-  std::vector<std::pair<CopyRank, const double*>> order;
-  order.reserve(touched.size());
-  for (const auto& [block, rank] : touched) order.emplace_back(rank, block);
-  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+IdOrderedCopy Window::CopyOf(const KeyedResiduals& residuals, const LandmarkFactors& extra) const {
+  std::unordered_set<BlockKey, BlockKeyHash> touched(residuals.keys.begin(), residuals.keys.end());
+  for (const auto& [landmark, factor] : extra) touched.insert(BlockKey::Landmark(landmark));
   IdOrderedCopy copy;
-  std::vector<size_t> offsets;
-  for (const auto& [rank, block] : order) {
-    copy.blocks.push_back(block);
-    offsets.push_back(copy.values.size());
+  copy.keys.assign(touched.begin(), touched.end());
+  std::sort(copy.keys.begin(), copy.keys.end(), [](const BlockKey& a, const BlockKey& b) { return RankOf(a) < RankOf(b); });
+  for (const BlockKey& key : copy.keys) {
+    double* block = BlockOf(key);
+    copy.place.emplace(key, copy.window_blocks.size());
+    copy.window_blocks.push_back(block);
+    copy.offsets.push_back(copy.values.size());
     copy.values.insert(copy.values.end(), block, block + problem_->ParameterBlockSize(block));
   }
-  for (size_t k = 0; k < copy.blocks.size(); ++k) copy.copy_of[copy.blocks[k]] = copy.values.data() + offsets[k];
   return copy;
 }
 
@@ -147,23 +171,21 @@ Window::IdOrderedCopy Window::CopyOf(const std::vector<ceres::ResidualBlockId>& 
 SolveReport Window::SolveSparse(const SolverOptions& options, const FrozenObservations& frozen) {
   const VariableIds variable = VariableIdsOf();
   if (variable.states.empty() && variable.landmarks.empty()) return SolveReport();
-  const Leaving solved = SolvedOf(variable);
   std::vector<std::unique_ptr<ceres::CostFunction>> factors;
   LandmarkFactors extra;
   for (LandmarkId id : variable.landmarks) {
     const auto it = frozen.landmarks.find(id);
     if (it == frozen.landmarks.end()) continue;
     factors.push_back(QuadraticLandmarkFactor(it->second));
-    extra.emplace_back(landmarks_.at(id).p_w, factors.back().get());
+    extra.emplace_back(id, factors.back().get());
   }
-  const std::vector<ceres::ResidualBlockId> residuals = RecentResidualOrderOf(solved);
-  return SolveCopy(options, residuals, extra, CopyOf(residuals, extra));
+  return SolveCopy(options, RecentResidualOrderOf(SolvedOf(variable)), extra);
 }
 
-std::vector<ceres::ResidualBlockId> Window::RecentResidualOrderOf(const Leaving& solved) const {
-  std::vector<ceres::ResidualBlockId> order;
+KeyedResiduals Window::RecentResidualOrderOf(const Leaving& solved) const {
+  KeyedResiduals order;
   for (const Prior& prior : priors_) {
-    if (Touches(prior, solved)) order.push_back(prior.residual);
+    if (Touches(prior, solved)) order.Add(prior.residual, prior.keys);
   }
   // The IMU factors into and out of the solved states, by their later state.
   std::set<StateId> edges;
@@ -172,14 +194,15 @@ std::vector<ceres::ResidualBlockId> Window::RecentResidualOrderOf(const Leaving&
     const auto out = imu_edges_.upper_bound(id);
     if (out != imu_edges_.end() && out->second.from == id) edges.insert(out->first);
   }
-  for (StateId to : edges) order.push_back(imu_edges_.at(to).residual);
+  for (StateId to : edges) order.Add(imu_edges_.at(to).residual, ImuKeys(imu_edges_.at(to).from, to));
+  const std::vector<BlockKey> calibration = CalibrationKeys();
   for (StateId id : solved.states) {
     for (auto it = observations_.lower_bound({id, LandmarkId(std::numeric_limits<std::int64_t>::min())});
          it != observations_.end() && it->first.first == id; ++it) {
-      order.push_back(it->second.residual);
+      order.Add(it->second.residual, PointKeys(id, it->first.second), calibration);
     }
   }
-  for (const ObservationKey& key : AnchoredKeysOf(solved)) order.push_back(anchored_points_.at(key));
+  AddAnchoredPoints(AnchoredKeysOf(solved), &order);
   return order;
 }
 
@@ -194,83 +217,61 @@ std::vector<ceres::ResidualBlockId> Window::RecentResidualOrderOf(const Leaving&
 // dense system. Landmarks first would leave a nearly dense system over every
 // pose; states first (the IMU chain) a dense block of every state against
 // every landmark.
-std::unordered_map<const double*, int> Window::EliminationGroups(const std::string& linear_solver,
-                                                                 const std::vector<const double*>& blocks) const {
+std::vector<int> Window::EliminationGroups(const std::string& linear_solver, const std::vector<BlockKey>& blocks) const {
   constexpr int kSegmentStates = 20;
   const bool segments = linear_solver == "sparse_full";
-  const std::set<const double*> in_prior = BlocksInPriors();
+  const std::set<LandmarkId> in_prior = LandmarksInPriors();
   std::map<StateId, int> place;  // sparse_full: each state's place in id order
   if (segments) {
     for (const auto& [id, s] : states_) place.emplace(id, static_cast<int>(place.size()));
   }
   const auto segment = [&](StateId id) { return place.at(id) / kSegmentStates; };
-  std::unordered_map<const double*, int> group;
-  for (const double* block : blocks) {
-    const BlockKey& key = block_keys_.at(block);
+  std::vector<int> groups;
+  groups.reserve(blocks.size());
+  for (const BlockKey& key : blocks) {
     if (key.kind == BlockKey::Kind::kPose || key.kind == BlockKey::Kind::kSpeedBias) {
       const bool separator = !segments || place.at(StateId(key.id)) % kSegmentStates == kSegmentStates - 1;
-      group[block] = separator ? 1 : 0;
+      groups.push_back(separator ? 1 : 0);
     } else if (key.kind == BlockKey::Kind::kLandmark) {
       const Landmark& landmark = landmarks_.at(LandmarkId(key.id));
       const bool one_segment = !segments || landmark.observed_from.empty() ||
                                segment(*landmark.observed_from.begin()) == segment(*landmark.observed_from.rbegin());
-      const bool eliminable = landmark.anchored_to.empty() && !in_prior.count(landmark.p_w);
-      group[block] = one_segment && eliminable ? 0 : 1;
+      const bool eliminable = landmark.anchored_to.empty() && !in_prior.count(landmark.id);
+      groups.push_back(one_segment && eliminable ? 0 : 1);
     } else {
-      group[block] = 1;  // calibration: seen by every observation
+      groups.push_back(1);  // calibration: seen by every observation
     }
   }
-  return group;
+  return groups;
 }
 
-// LM on the copy.
-SolveReport Window::SolveCopy(const SolverOptions& options, const std::vector<ceres::ResidualBlockId>& residuals,
-                              const LandmarkFactors& extra, const IdOrderedCopy& ids) {
+// LM on the copy; the list of residuals is freed once they are in it.
+SolveReport Window::SolveCopy(const SolverOptions& options, KeyedResiduals residuals, const LandmarkFactors& extra) {
+  IdOrderedCopy ids = CopyOf(residuals, extra);
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem copy(problem_options);
-  const std::unordered_map<const double*, int> groups = EliminationGroups(options.linear_solver, ids.blocks);
-  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-  for (const double* block : ids.blocks) {
-    double* c = ids.copy_of.at(block);
-    copy.AddParameterBlock(c, problem_->ParameterBlockSize(block),
-                           const_cast<ceres::Manifold*>(problem_->GetManifold(block)));
-    const bool constant = problem_->IsParameterBlockConstant(block);
-    if (constant) copy.SetParameterBlockConstant(c);
-    ordering->AddElementToGroup(c, constant ? 1 : groups.at(block));
-  }
-  for (ceres::ResidualBlockId residual : residuals) {
-    std::vector<double*> window_blocks;
-    problem_->GetParameterBlocksForResidualBlock(residual, &window_blocks);
-    for (double*& block : window_blocks) block = ids.copy_of.at(block);
-    copy.AddResidualBlock(const_cast<ceres::CostFunction*>(problem_->GetCostFunctionForResidualBlock(residual)),
-                          const_cast<ceres::LossFunction*>(problem_->GetLossFunctionForResidualBlock(residual)),
-                          window_blocks);
-  }
-  for (const auto& [block, factor] : extra) copy.AddResidualBlock(factor, nullptr, ids.copy_of.at(block));
+  const auto ordering = AddBlocks(*problem_, ids, EliminationGroups(options.linear_solver, ids.keys), &copy);
+  AddResiduals(*problem_, residuals, extra, ids, &copy);
+  residuals = KeyedResiduals();  // in the copy now: its memory is not held through the solve
   ceres::Solver::Options solver = LinearSolverOptions(options, ordering);
   SolveControlCallback control(solve_control_, solver.max_num_iterations);
   solver.callbacks.push_back(&control);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &copy, &summary);
-  VLOG(2) << "sparse solve of " << ids.blocks.size() << " blocks: " << summary.BriefReport();
-  SolveReport report;
-  report.iterations = static_cast<int>(summary.iterations.size());
-  report.initial_cost = summary.initial_cost;
-  report.final_cost = summary.final_cost;
-  report.usable = summary.IsSolutionUsable();
-  report.converged = summary.termination_type == ceres::CONVERGENCE;
-  report.stopped = control.stopped();
+  VLOG(2) << "sparse solve of " << ids.keys.size() << " blocks: " << summary.BriefReport();
+  const SolveReport report = control.ReportOf(summary);
   if (report.stopped) ++health_.stopped_solves;
   if (!report.usable) {
     ++health_.failed_solves;
     return report;
   }
-  for (const double* block : ids.blocks) {
+  for (std::size_t k = 0; k < ids.keys.size(); ++k) {
+    double* block = ids.window_blocks[k];
     if (problem_->IsParameterBlockConstant(block)) continue;
-    std::memcpy(const_cast<double*>(block), ids.copy_of.at(block), sizeof(double) * problem_->ParameterBlockSize(block));
+    std::memcpy(block, ids.values.data() + ids.offsets[k], sizeof(double) * problem_->ParameterBlockSize(block));
   }
   return report;
 }

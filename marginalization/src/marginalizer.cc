@@ -22,8 +22,11 @@ using BlockSet = std::unordered_set<const double*>;
 struct MarkovBlanket {
   /// Every residual block touching a marginalized block, in problem order.
   std::vector<ceres::ResidualBlockId> residual_blocks;
-  /// Variable blanket blocks, in order of first appearance.
+  /// Variable blanket blocks: those in kept_order first, in that order, then the others in order of
+  /// first appearance.
   std::vector<double*> kept;
+  /// Each kept block's place in kept_order (its size when not listed).
+  std::vector<size_t> kept_place;
   /// Variable marginalized blocks that share no residual block with one
   /// another: eliminated block by block.
   std::vector<double*> marg_uncoupled;
@@ -117,17 +120,24 @@ void SplitMarginalized(const ceres::Problem& problem, const std::vector<double*>
   }
 }
 
-/// The kept blocks listed in `order` first, in that order, then the others as they were.
-void OrderKept(const std::vector<const double*>& order, std::vector<double*>* kept) {
-  if (order.empty()) return;
+/// The kept blocks listed in `order` first, in that order, then the others as they were; `place`:
+/// each one's place in `order` (its size when not listed).
+void OrderKept(const std::vector<const double*>& order, std::vector<double*>* kept, std::vector<size_t>* place) {
   std::unordered_map<const double*, size_t> position;
   position.reserve(order.size());
   for (size_t k = 0; k < order.size(); ++k) position.emplace(order[k], k);
-  const auto rank = [&](const double* block) {
+  std::vector<std::pair<size_t, double*>> ranked;
+  ranked.reserve(kept->size());
+  for (double* block : *kept) {
     const auto it = position.find(block);
-    return it != position.end() ? it->second : order.size();
-  };
-  std::stable_sort(kept->begin(), kept->end(), [&](const double* a, const double* b) { return rank(a) < rank(b); });
+    ranked.emplace_back(it != position.end() ? it->second : order.size(), block);
+  }
+  std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  place->clear();
+  for (size_t k = 0; k < ranked.size(); ++k) {
+    place->push_back(ranked[k].first);
+    (*kept)[k] = ranked[k].second;
+  }
 }
 
 MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector<double*>& marg,
@@ -160,7 +170,7 @@ MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector
       }
     }
   }
-  OrderKept(options.kept_order, &blanket.kept);
+  OrderKept(options.kept_order, &blanket.kept, &blanket.kept_place);
   std::vector<int> marg_variable;
   for (size_t k = 0; k < marg.size(); ++k) {
     if (IsVariable(problem, marg[k])) marg_variable.push_back(static_cast<int>(k));
@@ -220,15 +230,17 @@ std::vector<MarginalizationPrior::Block> PriorBlocks(const ceres::Problem& probl
 
 /// FEJ: x0_i <- x_fe_i and r0 <- r0 + Jp_i (x_fe_i ⊟ x_i) for every kept block
 /// with a first estimate.
-void ReexpressAtFirstEstimates(const ceres::Problem& problem, const std::vector<double*>& kept,
-                               const std::function<const double*(const double*)>& first_estimate,
+void ReexpressAtFirstEstimates(const ceres::Problem& problem, const MarkovBlanket& blanket,
+                               const std::vector<const double*>& first_estimates,
                                const Eigen::MatrixXd& sqrt_information,
                                std::vector<MarginalizationPrior::Block>* blocks, Eigen::VectorXd* residual) {
+  const std::vector<double*>& kept = blanket.kept;
   int offset = 0;
   for (size_t i = 0; i < kept.size(); ++i) {
     const int tangent = problem.ParameterBlockTangentSize(kept[i]);
     MarginalizationPrior::Block& block = (*blocks)[i];
-    if (const double* first = first_estimate(kept[i])) {
+    const size_t place = blanket.kept_place[i];
+    if (const double* first = place < first_estimates.size() ? first_estimates[place] : nullptr) {
       Eigen::VectorXd delta(tangent);
       if (block.manifold != nullptr) {
         CHECK(block.manifold->Minus(first, kept[i], delta.data()));
@@ -258,14 +270,12 @@ std::unique_ptr<MarginalizationPrior> BuildPrior(ceres::Problem* problem,
     return nullptr;
   }
   std::vector<MarginalizationPrior::Block> blocks = PriorBlocks(*problem, blanket.kept);
-  if (options.first_estimate) {
-    ReexpressAtFirstEstimates(*problem, blanket.kept, options.first_estimate, sqrt.sqrt_information, &blocks,
-                              &sqrt.residual);
-  }
+  const bool fej = !options.first_estimates.empty();
+  if (fej) ReexpressAtFirstEstimates(*problem, blanket, options.first_estimates, sqrt.sqrt_information, &blocks, &sqrt.residual);
   std::unique_ptr<MarginalizationPrior> prior =
       MarginalizationPrior::Create(std::move(blocks), std::move(sqrt.sqrt_information), std::move(sqrt.residual),
                                    std::move(sqrt.information));
-  if (options.first_estimate) prior->HoldJacobianAtLinearizationPoint();
+  if (fej) prior->HoldJacobianAtLinearizationPoint();
   return prior;
 }
 
@@ -275,6 +285,9 @@ MarginalizationResult ComputeMarginalization(ceres::Problem* problem,
                                              const std::vector<double*>& to_marginalize,
                                              const MarginalizationOptions& options) {
   CHECK(problem != nullptr);
+  if (!options.first_estimates.empty() && options.first_estimates.size() != options.kept_order.size()) {
+    throw std::invalid_argument("marginalization: first_estimates and kept_order differ in length");
+  }
   const std::vector<double*> marg = UniqueBlocksInProblem(*problem, to_marginalize);
   MarkovBlanket blanket = FindMarkovBlanket(*problem, marg, options);
   MarginalizationResult result;

@@ -2,15 +2,20 @@
 // state system by sparse Cholesky, on a copy laid out by id) reaches the same
 // solution as the solves it replaced (Ceres over the window's own problem with
 // the whole system's sparse Cholesky), to 1e-8; it holds the constant blocks;
-// and a refinement of every frame from other start values reaches the minimum
-// of the same problem built directly.
+// two windows of one cost built in other orders solve to the same bits; and a
+// refinement of every frame from other start values reaches the minimum of the
+// same problem built directly.
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <map>
+#include <set>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "synthetic_window.h"
+#include "vio/estimator/frozen_observations.h"
 #include "vio/estimator/refinement.h"
 #include "vio/estimator/window.h"
 
@@ -117,6 +122,80 @@ TEST(WindowSparseSolve, WithoutTheResidualIndexRemovesAndSolvesToTheSameBits) {
   };
   const std::vector<double> indexed = solved(ResidualIndex::kPerBlock);
   EXPECT_EQ(solved(ResidualIndex::kNone), indexed);
+}
+
+// `source`'s states, IMU factors, landmarks and observations added to `window` with the time offset
+// and the extrinsics estimated, in id order or each kind in reverse (so their blocks and residuals lie
+// in another order in memory and in Ceres' problem), and an anchored point.
+void CopyWindow(const Window& source, bool reversed, Window& window) {
+  const auto in_order = [reversed](auto items) {
+    if (reversed) std::reverse(items.begin(), items.end());
+    return items;
+  };
+  window.EstimateTimeOffset(0.001, 0.005);
+  window.EstimateExtrinsics(0.01, 0.01);
+  std::vector<StateId> states;
+  for (const auto& [id, s] : source.states()) states.push_back(id);
+  for (StateId id : in_order(states)) {
+    State& s = window.AddState(id, source.state(id).t_ns);
+    std::copy(source.state(id).pose, source.state(id).pose + 7, s.pose);
+    std::copy(source.state(id).speed_bias, source.state(id).speed_bias + 9, s.speed_bias);
+  }
+  StatePrior prior;
+  prior.pose_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e-6;
+  prior.speed_bias_sigma.setConstant(0.1);
+  window.AddStatePrior(states.front(), prior);
+  for (StateId to : in_order(states)) {
+    StateId from;
+    if (const ImuPreintegration* imu = source.ImuFactorInto(to, &from)) window.AddImuFactor(from, to, *imu);
+  }
+  std::vector<LandmarkId> landmarks;
+  for (const auto& [id, landmark] : source.landmarks()) landmarks.push_back(id);
+  for (LandmarkId id : in_order(landmarks)) window.AddLandmark(id, source.landmark(id).position());
+  for (StateId id : in_order(states)) {
+    for (const auto& [landmark, z] : in_order(source.ObservationsOf(id))) window.AddObservation(id, landmark, z);
+  }
+  window.SetAnchoredPoint(states[2], landmarks.front(), Eigen::Vector3d(0.1, 0.2, 3.0), Eigen::Matrix3d::Identity());
+}
+
+// The copy SolveSparse solves is laid out by the keys the window gives each residual's blocks, the
+// marginalization's columns likewise: two windows of the same cost built in other orders reach the
+// same values to the last bit, through a marginalization (a prior on states, landmarks and the
+// calibration blocks) and the solves of batch (observations of a held state summarized) and the refinement.
+TEST(WindowSparseSolve, SameBitsForAWindowBuiltInAnotherOrder) {
+  for (const bool fej : {false, true}) {
+    const auto solved = [fej](bool reversed) {
+      ModelOptions model;
+      model.fej = fej;
+      Window source(model, Flight().stereo());
+      Flight().Build(source, model, kFirst, kFrames, kOffsetM);
+      Window window(model, Flight().stereo());
+      CopyWindow(source, reversed, window);
+      const State first = window.states().begin()->second;
+      const std::vector<LandmarkId> seen_first = [&] {
+        std::vector<LandmarkId> only;  // landmarks only the first state sees leave with it
+        for (const auto& [id, landmark] : window.landmarks()) {
+          if (landmark.observed_from == std::set<StateId>{first.id} && landmark.anchored_to.empty()) only.push_back(id);
+        }
+        return only;
+      }();
+      window.Marginalize({first.id}, seen_first);
+      EXPECT_EQ(window.num_priors(), 3);  // the time offset's, the extrinsics', the marginalization's
+      FrozenObservations frozen;
+      const StateId held = std::next(window.states().begin())->first;
+      window.SummarizeObservationsOf(held, frozen);
+      window.SetStateConstant(held, true);
+      EXPECT_TRUE(window.SolveSparse(Tight("lm", "sparse"), frozen).usable);
+      window.SetStateConstant(held, false);
+      EXPECT_TRUE(window.SolveSparse(Tight("lm", "sparse_full")).usable);
+      std::vector<double> values = AllValues(window);
+      values.push_back(window.time_offset_s());
+      for (int i = 0; i < 6; ++i) values.push_back(window.extrinsic_correction()[i]);
+      return values;
+    };
+    const std::vector<double> in_order = solved(false);
+    EXPECT_EQ(solved(true), in_order) << (fej ? "with" : "without") << " FEJ";
+  }
 }
 
 // The refinement builds the whole problem from the logged measurements: from

@@ -336,6 +336,33 @@ TEST_F(LinearChainTest, KeptOrderOrdersThePriorsBlocks) {
   EXPECT_LT(RelativeError(ordered.prior->information(), permuted), 1e-12);
 }
 
+// FEJ: a kept block with a first estimate (given along kept_order) gets its prior re-expressed
+// there, x0 = x_fe and r0 + Jp (x_fe - x): on this linear model the same residual at the current
+// values; a block without one keeps the current values. first_estimates must be as long as kept_order.
+TEST_F(LinearChainTest, FirstEstimatesAlongKeptOrderReexpressThePrior) {
+  const std::vector<double*> marginalized = {model_.block(0), model_.block(1)};
+  MarginalizationOptions options;
+  options.kept_order = {model_.block(3), model_.block(2)};
+  const MarginalizationResult current = ComputeMarginalization(&problem_, marginalized, options);
+  const std::vector<double> first = {model_.block(3)[0] + 0.5, model_.block(3)[1] - 0.25, model_.block(3)[2] + 1.0};
+  options.first_estimates = {first.data(), nullptr};
+  const MarginalizationResult held = ComputeMarginalization(&problem_, marginalized, options);
+  ASSERT_NE(current.prior, nullptr);
+  ASSERT_NE(held.prior, nullptr);
+  EXPECT_EQ(held.prior->linearization_point(0), first);
+  EXPECT_EQ(held.prior->linearization_point(1), current.prior->linearization_point(1));
+  EXPECT_TRUE(held.prior->jacobian_at_linearization_point());
+  const auto residual_at_current = [&](const MarginalizationPrior& prior) {
+    const double* values[] = {model_.block(3), model_.block(2)};
+    Eigen::VectorXd r(prior.num_residuals());
+    EXPECT_TRUE(prior.Evaluate(values, r.data(), nullptr));
+    return r;
+  };
+  EXPECT_LT((residual_at_current(*held.prior) - residual_at_current(*current.prior)).norm(), 1e-9);
+  options.first_estimates = {first.data()};
+  EXPECT_THROW(ComputeMarginalization(&problem_, marginalized, options), std::invalid_argument);
+}
+
 TEST_F(LinearChainTest, BlockNotInTheProblemIsRejected) {
   double stranger[2] = {0.0, 0.0};
   EXPECT_THROW(ComputeMarginalization(&problem_, {stranger}), std::invalid_argument);

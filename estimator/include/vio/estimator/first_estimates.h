@@ -42,6 +42,10 @@ struct BlockKey {
   static BlockKey TimeOffset() { return {Kind::kTimeOffset, 0}; }
   static BlockKey Extrinsics() { return {Kind::kExtrinsics, 0}; }
   bool operator<(const BlockKey& o) const { return kind != o.kind ? kind < o.kind : id < o.id; }
+  bool operator==(const BlockKey& o) const { return kind == o.kind && id == o.id; }
+  /// Whether it is one of state `s`'s blocks (its pose or speed/bias).
+  bool IsOf(StateId s) const { return (kind == Kind::kPose || kind == Kind::kSpeedBias) && id == s.value; }
+  bool IsCalibration() const { return kind == Kind::kTimeOffset || kind == Kind::kExtrinsics; }
 };
 
 /// The first estimates of the held blocks.

@@ -16,7 +16,6 @@
 #include <optional>
 #include <set>
 #include <string>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -34,6 +33,9 @@
 #include "vio/marginalization/marginalizer.h"
 
 namespace vio {
+
+struct KeyedResiduals;
+struct IdOrderedCopy;
 
 /// One estimator state: a frame's pose and speed/bias, as parameter blocks.
 struct State {
@@ -281,9 +283,6 @@ class Window {
   GaussNewtonLayout Layout() const;
 
  private:
-  /// The state blocks in a marginalization's kept order: speed/bias blocks,
-  /// poses, the time offset (MarginalizationOptions::kept_order).
-  std::vector<const double*> StateColumnOrder() const;
   struct ImuEdge {
     StateId from;
     StateId to;
@@ -296,7 +295,7 @@ class Window {
   };
   struct Prior {
     ceres::ResidualBlockId residual = nullptr;
-    std::vector<const double*> blocks;
+    std::vector<BlockKey> keys;  ///< of its parameter blocks, in its parameter order
   };
   using ObservationKey = std::pair<StateId, LandmarkId>;
   /// A state's camera timing (SetCameraTiming).
@@ -304,12 +303,14 @@ class Window {
     double applied_offset_s = 0;
     CameraMotion motion;
   };
-  /// States and landmarks leaving the window (marginalized or dropped), and
-  /// their parameter blocks.
+  /// States and landmarks leaving the window (marginalized or dropped), or a solve's variables
+  /// with the calibration blocks solved with them (SolvedOf).
   struct Leaving {
     std::set<StateId> states;
     std::set<LandmarkId> landmarks;
-    std::set<const double*> blocks;
+    std::set<BlockKey> calibration;
+    /// Whether the block is one of theirs.
+    bool Has(const BlockKey& key) const;
   };
 
   void AddImuResidual(ImuEdge& edge);
@@ -317,13 +318,16 @@ class Window {
   /// StereoCalibrationFactor on them, with the state's camera timing (window_calibration.cc).
   ceres::CostFunction* StereoFactorOf(StateId state, LandmarkId landmark, const Eigen::Vector3d& z_px) const;
   ceres::CostFunction* Wrap(ceres::CostFunction* factor) const { return wrapper_ ? wrapper_(factor) : factor; }
-  /// The parameter blocks of states ([pose, speed_bias] each), then landmarks.
+  /// The keys of the blocks of states ([pose, speed_bias] each), then landmarks.
+  static std::vector<BlockKey> KeysOf(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks);
+  /// The blocks of KeysOf(states, landmarks).
   std::vector<double*> Blocks(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks);
+  /// The parameter block of a state, landmark or estimated calibration block of the window.
+  double* BlockOf(const BlockKey& key) const;
   SolveReport GaussNewton(int max_steps, bool until_converged, const SolverOptions& options);
   SolveReport LevenbergMarquardt(const ceres::Solver::Options& base, const SolverOptions& options);
-  struct IdOrderedCopy;
   /// Factors of the copy beyond the window's residuals, each on one landmark block (the caller owns them).
-  using LandmarkFactors = std::vector<std::pair<const double*, ceres::CostFunction*>>;
+  using LandmarkFactors = std::vector<std::pair<LandmarkId, ceres::CostFunction*>>;
   struct VariableIds {
     std::vector<StateId> states;
     std::vector<LandmarkId> landmarks;
@@ -331,22 +335,34 @@ class Window {
   VariableIds VariableIdsOf() const;
   /// The variable blocks' Leaving, with the calibration blocks that are estimated and variable.
   Leaving SolvedOf(const VariableIds& variable);
-  IdOrderedCopy CopyOf(const std::vector<ceres::ResidualBlockId>& residuals, const LandmarkFactors& extra) const;
-  /// The elimination group of each of `blocks` (states, landmarks, calibration).
-  std::unordered_map<const double*, int> EliminationGroups(const std::string& linear_solver,
-                                                           const std::vector<const double*>& blocks) const;
-  SolveReport SolveCopy(const SolverOptions& options, const std::vector<ceres::ResidualBlockId>& residuals,
-                        const LandmarkFactors& extra, const IdOrderedCopy& ids);
+  IdOrderedCopy CopyOf(const KeyedResiduals& residuals, const LandmarkFactors& extra) const;
+  /// The elimination group of each block (states, landmarks, calibration), by its key.
+  std::vector<int> EliminationGroups(const std::string& linear_solver, const std::vector<BlockKey>& blocks) const;
+  /// Levenberg-Marquardt on the copy of `residuals` and `extra` (`residuals` freed before it starts).
+  SolveReport SolveCopy(const SolverOptions& options, KeyedResiduals residuals, const LandmarkFactors& extra);
   /// The residuals SolveSparse(options, frozen) copies: those of the variable states (priors, IMU
   /// factors, observations, anchored points) and the priors on the variable landmarks, in ResidualOrder().
-  std::vector<ceres::ResidualBlockId> RecentResidualOrderOf(const Leaving& solved) const;
-  std::set<const double*> BlocksInPriors() const;
+  KeyedResiduals RecentResidualOrderOf(const Leaving& solved) const;
+  /// The landmarks some prior holds.
+  std::set<LandmarkId> LandmarksInPriors() const;
   /// Every residual block: priors in creation order, IMU factors and
   /// observations by ids (never by address).
   std::vector<ceres::ResidualBlockId> ResidualOrder() const;
   Leaving LeavingOf(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks);
-  /// ResidualOrder() restricted to the residuals of what leaves.
-  std::vector<ceres::ResidualBlockId> ResidualOrderOf(const Leaving& leaving) const;
+  /// ResidualOrder() restricted to the residuals of what leaves, with their blocks' keys.
+  KeyedResiduals ResidualOrderOf(const Leaving& leaving) const;
+  /// Appends the anchored points `keys` to `order`.
+  void AddAnchoredPoints(const std::set<ObservationKey>& keys, KeyedResiduals* order) const;
+  /// The blocks the residuals of what leaves touch that stay (its Markov blanket), in the
+  /// marginalization's column order (MarginalizationOptions::kept_order): speed/bias blocks, then
+  /// poses (by state id), the time offset, then the others in order of first appearance.
+  std::vector<BlockKey> KeptOrderOf(const KeyedResiduals& residuals, const Leaving& leaving) const;
+  /// The options of a marginalization of what leaves over `residuals` (kept order, first estimates).
+  marginalization::MarginalizationOptions MarginalizationOptionsOf(const KeyedResiduals& residuals,
+                                                                   const Leaving& leaving,
+                                                                   std::vector<BlockKey>* kept_order);
+  /// Keeps a marginalization's prior: its keys (a subsequence of `kept_order`), its first estimates.
+  void KeepPrior(ceres::ResidualBlockId prior, const std::vector<BlockKey>& kept_order);
   /// The observations of what leaves, in the map's order.
   std::set<ObservationKey> ObservationKeysOf(const Leaving& leaving) const;
   bool Touches(const Prior& prior, const Leaving& leaving) const;
@@ -355,10 +371,12 @@ class Window {
   std::shared_ptr<ceres::ParameterBlockOrdering> StatesFirstOrdering() const;
   void ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const;
   void ForgetResidualsOf(const Leaving& leaving);
-  std::set<ceres::ResidualBlockId> DropUnevaluableResiduals(const std::vector<double*>& blocks);
-  /// MarginalizeBlocks, after DropUnevaluableResiduals only when it fails: the prior, or null.
-  ceres::ResidualBlockId MarginalizeEvaluable(const std::vector<double*>& blocks,
-                                              marginalization::MarginalizationOptions options);
+  /// Removes the residuals that do not evaluate (finitely) at the current values from the problem and the list.
+  void DropUnevaluableResiduals(KeyedResiduals* residuals);
+  /// MarginalizeBlocks of what leaves over `residuals`, after DropUnevaluableResiduals only when it
+  /// fails: the prior, or null; `kept_order`: its kept blocks' order (KeptOrderOf).
+  ceres::ResidualBlockId MarginalizeEvaluable(const std::vector<double*>& blocks, KeyedResiduals residuals,
+                                              const Leaving& leaving, std::vector<BlockKey>* kept_order);
   /// The observations whose residual does not evaluate (finitely) at the current values, by ids.
   std::vector<ObservationKey> UnevaluableObservations() const;
   /// Drops `observations`, and a landmark left unobserved that no prior holds.
@@ -381,9 +399,7 @@ class Window {
   ceres::CostFunction* WithFirstEstimates(ceres::CostFunction* factor, std::vector<BlockKey> keys) const;
   /// FEJ: holds the blocks of a new prior at their current values (blocks with
   /// a first estimate keep it).
-  void HoldFirstEstimates(const std::vector<double*>& blocks);
-  /// The key of a state or landmark block of the window.
-  BlockKey KeyOf(const double* block) const;
+  void HoldFirstEstimates(const std::vector<BlockKey>& keys);
 
   ModelOptions model_;
   /// The given rig, one object that every stereo factor of the window shares (immutable: the
@@ -398,8 +414,6 @@ class Window {
   /// variables without a walk over everything the window keeps.
   std::set<StateId> variable_states_;
   std::set<LandmarkId> variable_landmarks_;
-  /// The key of every state, landmark and calibration block (a lookup only: copies are ordered by key).
-  std::unordered_map<const double*, BlockKey> block_keys_;
   std::map<StateId, ImuEdge> imu_edges_;  ///< keyed by the later state (`to`)
   std::map<ObservationKey, Observation> observations_;
   std::map<ObservationKey, ceres::ResidualBlockId> anchored_points_;
@@ -413,6 +427,8 @@ class Window {
   std::vector<std::pair<double*, BlockKey>> KeyedCalibrationBlocks() const;
   /// KeyedCalibrationBlocks()' blocks alone.
   std::vector<double*> CalibrationBlocks() const;
+  /// KeyedCalibrationBlocks()' keys alone.
+  std::vector<BlockKey> CalibrationKeys() const;
   /// The marginal covariance of `block` (a calibration block), as TimeOffsetSigma.
   std::optional<Eigen::MatrixXd> CalibrationCovariance(const double* block);
   /// Whether the last marginalization's prior had fewer rows than columns

@@ -19,7 +19,6 @@
 // current value); if it is made variable later the prior says nothing about
 // it. A constant block in `to_marginalize` is conditioned on, not integrated
 // out: its residuals still feed the prior on the blanket.
-#include <functional>
 #include <memory>
 #include <vector>
 
@@ -44,13 +43,6 @@ struct MarginalizationOptions {
   /// hold every residual block touching a marginalized block). Empty: the
   /// problem's order, which Ceres' block removal makes depend on addresses.
   std::vector<ceres::ResidualBlockId> residual_order;
-  /// First-estimate Jacobians (FEJ), when set: the first estimate of a kept
-  /// block (AmbientSize values), or nullptr when it has none. The prior is
-  /// linearized at the current values as always, then re-expressed at the
-  /// first estimates, x0_i = x_fe_i, r0 <- r0 + Jp_i (x_fe_i ⊟ x_i) (exact at
-  /// x_fe for the linear model), and holds its Jacobian at x0
-  /// (MarginalizationPrior::HoldJacobianAtLinearizationPoint).
-  std::function<const double*(const double* block)> first_estimate;
   /// The kept blocks' column order, when not empty: the kept blocks listed
   /// here come first, in this order, then the others in order of first
   /// appearance. A window passes its state blocks with the poses last and the
@@ -59,6 +51,14 @@ struct MarginalizationOptions {
   /// then mostly one contiguous range, and its Schur update one rank update in
   /// place.
   std::vector<const double*> kept_order;
+  /// First-estimate Jacobians (FEJ), when not empty (then as long as
+  /// kept_order): the first estimate of each kept_order block (AmbientSize
+  /// values), or nullptr when it has none; a kept block not listed has none.
+  /// The prior is linearized at the current values as always, then
+  /// re-expressed at the first estimates, x0_i = x_fe_i,
+  /// r0 <- r0 + Jp_i (x_fe_i ⊟ x_i) (exact at x_fe for the linear model), and
+  /// holds its Jacobian at x0 (MarginalizationPrior::HoldJacobianAtLinearizationPoint).
+  std::vector<const double*> first_estimates;
   /// A system of the same problem to assemble in (re-laid out, its buffers
   /// reused from one marginalization to the next), or nullptr for a new one.
   BlockSystem* system = nullptr;
@@ -80,7 +80,8 @@ struct MarginalizationResult {
 /// blanket, without changing the problem (the problem is not const: Ceres
 /// hands out its blocks through non-const accessors).
 /// Duplicates in `to_marginalize` are ignored. Throws std::invalid_argument if
-/// a block is not in the problem, std::runtime_error if evaluation fails.
+/// a block is not in the problem or first_estimates is neither empty nor as
+/// long as kept_order, std::runtime_error if evaluation fails.
 MarginalizationResult ComputeMarginalization(ceres::Problem* problem,
                                              const std::vector<double*>& to_marginalize,
                                              const MarginalizationOptions& options = {});
