@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "vio/marginalization/linear_algebra.h"
 #include "vio/marginalization/local_coordinates_jacobian.h"
 
 namespace vio::marginalization {
@@ -52,7 +53,7 @@ void ValidatePrior(const std::vector<MarginalizationPrior::Block>& blocks,
             << " rows; expected rows > 0, equal, and " << tangent_dim << " columns";
     throw std::invalid_argument(message.str());
   }
-  if (!sqrt_information.allFinite() || !residual_at_x0.allFinite()) {
+  if (!AllFinite(sqrt_information) || !AllFinite(residual_at_x0)) {
     throw std::invalid_argument("MarginalizationPrior: non-finite sqrt_information or residual");
   }
 }
@@ -73,7 +74,7 @@ std::unique_ptr<MarginalizationPrior> MarginalizationPrior::Create(std::vector<B
                                                                    Eigen::MatrixXd information) {
   ValidatePrior(blocks, sqrt_information, residual_at_x0);
   if (information.rows() != sqrt_information.cols() || information.cols() != sqrt_information.cols() ||
-      !information.allFinite()) {
+      !AllFinite(information)) {
     std::ostringstream message;
     message << "MarginalizationPrior: information is " << information.rows() << "x" << information.cols()
             << "; expected a finite " << sqrt_information.cols() << "x" << sqrt_information.cols() << " matrix";
