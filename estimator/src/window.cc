@@ -278,8 +278,9 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   std::vector<double*> blocks = Blocks(state_ids, landmark_ids);
   if (blocks.empty()) return;
   const Leaving leaving = LeavingOf(state_ids, landmark_ids);
+  const LeavingKeys keys = LeavingKeysOf(leaving);
   marginalization::MarginalizationOptions options;
-  options.residual_order = ResidualOrderOf(leaving);
+  options.residual_order = ResidualOrderOf(leaving, keys);
   options.kept_order = StateColumnOrder();
   if (marginal_system_ == nullptr) {
     marginal_system_ = std::make_unique<marginalization::BlockSystem>(problem_.get(), marginalization::BlockLayout{});
@@ -291,7 +292,7 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   if (first_estimates_) {
     options.first_estimate = [this](const double* block) { return first_estimates_->Find(KeyOf(block)); };
   }
-  ForgetResidualsOf(leaving);
+  ForgetResidualsOf(leaving, keys);
   const ceres::ResidualBlockId prior = MarginalizeEvaluable(blocks, std::move(options));
   last_prior_rank_deficient_ = false;
   if (prior != nullptr) {
@@ -323,12 +324,14 @@ Window::Leaving Window::LeavingOf(const std::vector<StateId>& states, const std:
 
 // Drops the bookkeeping of every residual of what leaves; the residual blocks
 // themselves go with their parameter blocks.
-void Window::ForgetResidualsOf(const Leaving& leaving) {
-  for (const ObservationKey& key : ObservationKeysOf(leaving)) {
+void Window::ForgetResidualsOf(const Leaving& leaving) { ForgetResidualsOf(leaving, LeavingKeysOf(leaving)); }
+
+void Window::ForgetResidualsOf(const Leaving& leaving, const LeavingKeys& keys) {
+  for (const ObservationKey& key : keys.observations) {
     landmarks_.at(key.second).observed_from.erase(key.first);
     observations_.erase(key);
   }
-  for (const ObservationKey& key : AnchoredKeysOf(leaving)) {
+  for (const ObservationKey& key : keys.anchored) {
     landmarks_.at(key.second).anchored_to.erase(key.first);
     anchored_points_.erase(key);
   }

@@ -78,7 +78,11 @@ bool Window::Touches(StateId to, const ImuEdge& edge, const Leaving& leaving) co
   return leaving.states.count(edge.from) > 0 || leaving.states.count(to) > 0;
 }
 
-std::vector<ceres::ResidualBlockId> Window::ResidualOrderOf(const Leaving& leaving) const {
+Window::LeavingKeys Window::LeavingKeysOf(const Leaving& leaving) const {
+  return {ObservationKeysOf(leaving), AnchoredKeysOf(leaving)};
+}
+
+std::vector<ceres::ResidualBlockId> Window::ResidualOrderOf(const Leaving& leaving, const LeavingKeys& keys) const {
   std::vector<ceres::ResidualBlockId> order;
   for (const Prior& prior : priors_) {
     if (Touches(prior, leaving)) order.push_back(prior.residual);
@@ -86,8 +90,8 @@ std::vector<ceres::ResidualBlockId> Window::ResidualOrderOf(const Leaving& leavi
   for (const auto& [to, edge] : imu_edges_) {
     if (Touches(to, edge, leaving)) order.push_back(edge.residual);
   }
-  for (const ObservationKey& key : ObservationKeysOf(leaving)) order.push_back(observations_.at(key).residual);
-  for (const ObservationKey& key : AnchoredKeysOf(leaving)) order.push_back(anchored_points_.at(key));
+  for (const ObservationKey& key : keys.observations) order.push_back(observations_.at(key).residual);
+  for (const ObservationKey& key : keys.anchored) order.push_back(anchored_points_.at(key));
   return order;
 }
 

@@ -96,7 +96,7 @@ SolveReport Window::SolveSparse(const SolverOptions& options) {
   const VariableIds variable = VariableIdsOf();
   if (variable.states.empty() && variable.landmarks.empty()) return SolveReport();
   const Leaving solved = SolvedOf(variable);
-  const std::vector<ceres::ResidualBlockId> residuals = ResidualOrderOf(solved);
+  const std::vector<ceres::ResidualBlockId> residuals = ResidualOrderOf(solved, LeavingKeysOf(solved));
   return SolveCopy(options, residuals, {}, CopyOf(residuals, {}));
 }
 

@@ -122,11 +122,19 @@ bool MarginalizationPrior::TangentJacobians(double const* const* parameters, Eig
   return true;
 }
 
-bool MarginalizationPrior::Linearize(double const* const* parameters, TangentLinearization* at) const {
+bool MarginalizationPrior::Linearize(double const* const* parameters, TangentLinearization* at,
+                                     bool with_cost) const {
   Eigen::VectorXd delta;
   if (!TangentJacobians(parameters, &delta, &at->T)) return false;
-  at->cost = 0.5 * (residual_at_x0_ + sqrt_information_ * delta).squaredNorm();
-  at->g = information_vector_ + information_ * delta;
+  if (delta.isZero(0.0)) {
+    // At x0 (a prior's first solve): the products with delta are exact zeros, and adding them
+    // changes only a -0 into +0, as adding 0.0 does.
+    at->cost = with_cost ? 0.5 * residual_at_x0_.squaredNorm() : 0.0;
+    at->g = (information_vector_.array() + 0.0).matrix();
+  } else {
+    at->cost = with_cost ? 0.5 * (residual_at_x0_ + sqrt_information_ * delta).squaredNorm() : 0.0;
+    at->g = information_vector_ + information_ * delta;
+  }
   for (size_t i = 0; i < blocks_.size(); ++i) {
     Eigen::MatrixXd& T = at->T[i];
     if (T.isIdentity(0.0)) {

@@ -39,6 +39,7 @@ std::vector<double*> UniqueBlocksInProblem(const ceres::Problem& problem,
                                            const std::vector<double*>& blocks) {
   std::vector<double*> unique;
   BlockSet seen;
+  seen.reserve(blocks.size());
   for (double* block : blocks) {
     if (!problem.HasParameterBlock(block)) {
       std::ostringstream message;
@@ -57,6 +58,7 @@ std::vector<ceres::ResidualBlockId> ResidualBlocksTouching(const ceres::Problem&
                                                            const std::vector<double*>& marg,
                                                            const std::vector<ceres::ResidualBlockId>& order) {
   std::unordered_set<ceres::ResidualBlockId> touching;
+  touching.reserve(order.size());
   std::vector<ceres::ResidualBlockId> of_block;
   for (const double* block : marg) {
     problem.GetResidualBlocksForParameterBlock(block, &of_block);
@@ -137,6 +139,9 @@ MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector
   std::unordered_map<const double*, int> marg_index;
   marg_index.reserve(marg.size());
   for (size_t k = 0; k < marg.size(); ++k) marg_index.emplace(marg[k], static_cast<int>(k));
+  // Whether each marginalized block is variable, looked up once (not once per residual touching it).
+  std::vector<char> marg_is_variable(marg.size());
+  for (size_t k = 0; k < marg.size(); ++k) marg_is_variable[k] = IsVariable(problem, marg[k]) ? 1 : 0;
   BlockSet kept_seen;
   std::vector<std::pair<int, int>> pairs;
   std::vector<double*> touched;
@@ -145,12 +150,10 @@ MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector
     problem.GetParameterBlocksForResidualBlock(residual_block, &touched);
     marg_here.clear();
     for (double* block : touched) {
-      if (!IsVariable(problem, block)) {
-        continue;
-      }
       if (const auto it = marg_index.find(block); it != marg_index.end()) {
-        marg_here.push_back(it->second);
-      } else if (kept_seen.insert(block).second) {
+        if (marg_is_variable[static_cast<size_t>(it->second)] != 0) marg_here.push_back(it->second);
+      } else if (kept_seen.count(block) == 0 && IsVariable(problem, block)) {  // a variable blanket block, first seen
+        kept_seen.insert(block);
         blanket.kept.push_back(block);
       }
     }
@@ -163,7 +166,7 @@ MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector
   OrderKept(options.kept_order, &blanket.kept);
   std::vector<int> marg_variable;
   for (size_t k = 0; k < marg.size(); ++k) {
-    if (IsVariable(problem, marg[k])) marg_variable.push_back(static_cast<int>(k));
+    if (marg_is_variable[k] != 0) marg_variable.push_back(static_cast<int>(k));
   }
   SplitMarginalized(problem, marg, marg_variable, Couplings(marg.size(), std::move(pairs)), &blanket);
   return blanket;
@@ -197,8 +200,7 @@ NormalEquations ReducedBlanket(ceres::Problem* problem, const MarkovBlanket& bla
   } else {
     system = &own.emplace(problem, std::move(layout), options.rank_threshold);
   }
-  double cost = 0.0;
-  if (!system->Reduce(&cost)) {
+  if (!system->Reduce(/*cost=*/nullptr)) {
     throw std::runtime_error("marginalization: the Markov blanket's residuals do not evaluate (or are not finite)");
   }
   NormalEquations reduced;
@@ -269,13 +271,9 @@ std::unique_ptr<MarginalizationPrior> BuildPrior(ceres::Problem* problem,
   return prior;
 }
 
-}  // namespace
-
-MarginalizationResult ComputeMarginalization(ceres::Problem* problem,
-                                             const std::vector<double*>& to_marginalize,
-                                             const MarginalizationOptions& options) {
-  CHECK(problem != nullptr);
-  const std::vector<double*> marg = UniqueBlocksInProblem(*problem, to_marginalize);
+/// ComputeMarginalization of blocks that are in the problem, each once.
+MarginalizationResult MarginalizationOfUnique(ceres::Problem* problem, const std::vector<double*>& marg,
+                                              const MarginalizationOptions& options) {
   MarkovBlanket blanket = FindMarkovBlanket(*problem, marg, options);
   MarginalizationResult result;
   result.marginalized_residual_blocks = blanket.residual_blocks;
@@ -288,11 +286,22 @@ MarginalizationResult ComputeMarginalization(ceres::Problem* problem,
   return result;
 }
 
+}  // namespace
+
+MarginalizationResult ComputeMarginalization(ceres::Problem* problem,
+                                             const std::vector<double*>& to_marginalize,
+                                             const MarginalizationOptions& options) {
+  CHECK(problem != nullptr);
+  return MarginalizationOfUnique(problem, UniqueBlocksInProblem(*problem, to_marginalize), options);
+}
+
 ceres::ResidualBlockId MarginalizeBlocks(ceres::Problem* problem,
                                          const std::vector<double*>& to_marginalize,
                                          const MarginalizationOptions& options) {
-  MarginalizationResult result = ComputeMarginalization(problem, to_marginalize, options);
-  for (const double* block : UniqueBlocksInProblem(*problem, to_marginalize)) {
+  CHECK(problem != nullptr);
+  const std::vector<double*> marg = UniqueBlocksInProblem(*problem, to_marginalize);
+  MarginalizationResult result = MarginalizationOfUnique(problem, marg, options);
+  for (const double* block : marg) {
     problem->RemoveParameterBlock(block);
   }
   if (result.prior == nullptr) {

@@ -345,8 +345,15 @@ class Window {
   /// observations by ids (never by address).
   std::vector<ceres::ResidualBlockId> ResidualOrder() const;
   Leaving LeavingOf(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks);
-  /// ResidualOrder() restricted to the residuals of what leaves.
-  std::vector<ceres::ResidualBlockId> ResidualOrderOf(const Leaving& leaving) const;
+  /// The observations and anchored points of what leaves, found once for a marginalization's
+  /// residual order and its bookkeeping.
+  struct LeavingKeys {
+    std::set<ObservationKey> observations;
+    std::set<ObservationKey> anchored;
+  };
+  LeavingKeys LeavingKeysOf(const Leaving& leaving) const;
+  /// ResidualOrder() restricted to the residuals of what leaves (`keys`: LeavingKeysOf(leaving)).
+  std::vector<ceres::ResidualBlockId> ResidualOrderOf(const Leaving& leaving, const LeavingKeys& keys) const;
   /// The observations of what leaves, in the map's order.
   std::set<ObservationKey> ObservationKeysOf(const Leaving& leaving) const;
   bool Touches(const Prior& prior, const Leaving& leaving) const;
@@ -355,6 +362,7 @@ class Window {
   std::shared_ptr<ceres::ParameterBlockOrdering> StatesFirstOrdering() const;
   void ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const;
   void ForgetResidualsOf(const Leaving& leaving);
+  void ForgetResidualsOf(const Leaving& leaving, const LeavingKeys& keys);
   std::set<ceres::ResidualBlockId> DropUnevaluableResiduals(const std::vector<double*>& blocks);
   /// MarginalizeBlocks, after DropUnevaluableResiduals only when it fails: the prior, or null.
   ceres::ResidualBlockId MarginalizeEvaluable(const std::vector<double*>& blocks,
