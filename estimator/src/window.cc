@@ -280,6 +280,7 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   const LeavingKeys keys = LeavingKeysOf(leaving);
   marginalization::MarginalizationOptions options;
   options.residual_order = ResidualOrderOf(leaving, keys);
+  options.residual_order_is_exact = true;  // every residual of what leaves, by the window's bookkeeping
   options.kept_order = StateColumnOrder();
   if (marginal_system_ == nullptr) {
     marginal_system_ = std::make_unique<marginalization::BlockSystem>(problem_.get(), marginalization::BlockLayout{});

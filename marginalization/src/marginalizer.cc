@@ -56,7 +56,9 @@ std::vector<double*> UniqueBlocksInProblem(const ceres::Problem& problem,
 
 std::vector<ceres::ResidualBlockId> ResidualBlocksTouching(const ceres::Problem& problem,
                                                            const std::vector<double*>& marg,
-                                                           const std::vector<ceres::ResidualBlockId>& order) {
+                                                           const std::vector<ceres::ResidualBlockId>& order,
+                                                           bool order_is_exact) {
+  if (order_is_exact) return order;  // FindMarkovBlanket checks that each touches a marginalized block
   std::unordered_set<ceres::ResidualBlockId> touching;
   touching.reserve(order.size());
   std::vector<ceres::ResidualBlockId> of_block;
@@ -135,7 +137,8 @@ void OrderKept(const std::vector<const double*>& order, std::vector<double*>* ke
 MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector<double*>& marg,
                                 const MarginalizationOptions& options) {
   MarkovBlanket blanket;
-  blanket.residual_blocks = ResidualBlocksTouching(problem, marg, options.residual_order);
+  blanket.residual_blocks =
+      ResidualBlocksTouching(problem, marg, options.residual_order, options.residual_order_is_exact);
   std::unordered_map<const double*, int> marg_index;
   marg_index.reserve(marg.size());
   for (size_t k = 0; k < marg.size(); ++k) marg_index.emplace(marg[k], static_cast<int>(k));
@@ -149,14 +152,17 @@ MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector
   for (const ceres::ResidualBlockId residual_block : blanket.residual_blocks) {
     problem.GetParameterBlocksForResidualBlock(residual_block, &touched);
     marg_here.clear();
+    bool touches_marg = false;
     for (double* block : touched) {
       if (const auto it = marg_index.find(block); it != marg_index.end()) {
+        touches_marg = true;
         if (marg_is_variable[static_cast<size_t>(it->second)] != 0) marg_here.push_back(it->second);
       } else if (kept_seen.count(block) == 0 && IsVariable(problem, block)) {  // a variable blanket block, first seen
         kept_seen.insert(block);
         blanket.kept.push_back(block);
       }
     }
+    CHECK(touches_marg) << "residual_order_is_exact: a residual of the order touches no marginalized block";
     for (const int a : marg_here) {
       for (const int b : marg_here) {
         if (a != b) pairs.emplace_back(a, b);

@@ -44,6 +44,10 @@ struct MarginalizationOptions {
   /// hold every residual block touching a marginalized block). Empty: the
   /// problem's order, which Ceres' block removal makes depend on addresses.
   std::vector<ceres::ResidualBlockId> residual_order;
+  /// residual_order holds exactly the residual blocks touching a marginalized block (the caller keeps
+  /// that bookkeeping): the problem is not asked for them. Without Ceres' enable_fast_removal the
+  /// problem keeps no residuals per block, and asking scans every residual once per block.
+  bool residual_order_is_exact = false;
   /// First-estimate Jacobians (FEJ), when set: the first estimate of a kept
   /// block (AmbientSize values), or nullptr when it has none. The prior is
   /// linearized at the current values as always, then re-expressed at the
