@@ -110,7 +110,8 @@ struct WindowHealth {
 /// How the window's Ceres problem finds the residuals of a parameter block. kPerBlock: every
 /// block keeps the set of its residuals (Ceres' enable_fast_removal), so removing a state or
 /// landmark costs what it touches; about 130 B per observation. kNone: no sets; a removal scans
-/// every residual: for windows that keep everything and remove little (batch, the refinement).
+/// every residual: for windows that keep everything and remove little (batch, the refinement), or hold
+/// few residuals (the MSCKF without a local map: one frame's tracks).
 enum class ResidualIndex { kPerBlock, kNone };
 
 class Window {
