@@ -16,9 +16,12 @@
 namespace vio {
 namespace {
 
-// Batch keeps every state and landmark: its window removes only re-preintegrated IMU factors.
+// Batch keeps every state and landmark: its window removes only re-preintegrated IMU factors. The
+// MSCKF without a local map holds one frame's tracks: a removal's scan of its few hundred residuals
+// costs less than a hash-set node per residual and parameter block.
 ResidualIndex ResidualIndexFor(const EstimatorOptions& options) {
-  return options.policy.policy == "batch" ? ResidualIndex::kNone : ResidualIndex::kPerBlock;
+  const bool one_frames_tracks = options.policy.policy == "msckf" && options.local_map.local_map_keyframes == 0;
+  return options.policy.policy == "batch" || one_frames_tracks ? ResidualIndex::kNone : ResidualIndex::kPerBlock;
 }
 
 }  // namespace

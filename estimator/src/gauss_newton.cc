@@ -20,28 +20,49 @@ marginalization::BlockLayout BlockLayoutOf(const GaussNewtonLayout& layout) {
   return {layout.dense, layout.eliminated, layout.residuals};
 }
 
-void ApplyStep(ceres::Problem* problem, const std::vector<double*>& blocks, const Eigen::VectorXd& dx,
-               int first_col) {
-  int col = first_col;
+/// A layout block's sizes and manifold, looked up in the problem once per layout.
+struct BlockShape {
+  double* values = nullptr;
+  int size = 0;     ///< ambient
+  int tangent = 0;
+  const ceres::Manifold* manifold = nullptr;
+};
+
+std::vector<BlockShape> ShapesOf(const ceres::Problem& problem, const std::vector<double*>& dense,
+                                 const std::vector<double*>& eliminated) {
+  std::vector<BlockShape> shapes;
+  shapes.reserve(dense.size() + eliminated.size());
+  for (const std::vector<double*>* blocks : {&dense, &eliminated}) {
+    for (double* block : *blocks) {
+      shapes.push_back({block, problem.ParameterBlockSize(block), problem.ParameterBlockTangentSize(block),
+                        problem.GetManifold(block)});
+    }
+  }
+  return shapes;
+}
+
+// x <- x ⊞ dx over the blocks, dense then eliminated (dx's column order).
+void ApplyStep(const std::vector<BlockShape>& shapes, const Eigen::VectorXd& dx) {
+  int col = 0;
   std::vector<double> moved;
-  for (double* block : blocks) {
-    const int size = problem->ParameterBlockSize(block);
-    const ceres::Manifold* manifold = problem->GetManifold(block);
-    if (manifold == nullptr) {
-      for (int k = 0; k < size; ++k) block[k] += dx[col + k];
+  for (const BlockShape& shape : shapes) {
+    double* block = shape.values;
+    if (shape.manifold == nullptr) {
+      for (int k = 0; k < shape.size; ++k) block[k] += dx[col + k];
     } else {
-      moved.resize(static_cast<size_t>(size));
-      CHECK(manifold->Plus(block, dx.data() + col, moved.data()));
+      moved.resize(static_cast<size_t>(shape.size));
+      CHECK(shape.manifold->Plus(block, dx.data() + col, moved.data()));
       std::copy(moved.begin(), moved.end(), block);
     }
-    col += problem->ParameterBlockTangentSize(block);
+    col += shape.tangent;
   }
 }
 
-double SquaredNorm(const ceres::Problem& problem, const std::vector<double*>& blocks) {
+// The squared norm of shapes [first, last)'s values.
+double SquaredNorm(const std::vector<BlockShape>& shapes, size_t first, size_t last) {
   double sum = 0;
-  for (const double* block : blocks) {
-    for (int k = 0; k < problem.ParameterBlockSize(block); ++k) sum += block[k] * block[k];
+  for (size_t b = first; b < last; ++b) {
+    for (int k = 0; k < shapes[b].size; ++k) sum += shapes[b].values[k] * shapes[b].values[k];
   }
   return sum;
 }
@@ -82,16 +103,20 @@ struct GaussNewtonSolver::System {
   /// The layout's values before the last step, dense then eliminated blocks.
   std::vector<double> before_step;
   Eigen::MatrixXd dense_factor;  ///< SolveDense's factor, kept between steps
+  /// The layout's blocks, dense then eliminated (the columns' order).
+  std::vector<BlockShape> shapes;
 
   System(ceres::Problem* p, GaussNewtonLayout l)
       : problem(p), layout(std::move(l)), equations(p, BlockLayoutOf(layout)) {
     FindChain();
+    shapes = ShapesOf(*problem, layout.dense, layout.eliminated);
   }
 
   void Relayout(GaussNewtonLayout l) {
     layout = std::move(l);
     equations.Relayout(BlockLayoutOf(layout));
     FindChain();
+    shapes = ShapesOf(*problem, layout.dense, layout.eliminated);
     before_step.clear();
   }
 
@@ -127,22 +152,15 @@ struct GaussNewtonSolver::System {
 
   void SaveValues() {
     before_step.clear();
-    for (const std::vector<double*>* blocks : {&layout.dense, &layout.eliminated}) {
-      for (const double* block : *blocks) {
-        before_step.insert(before_step.end(), block, block + problem->ParameterBlockSize(block));
-      }
-    }
+    for (const BlockShape& shape : shapes) before_step.insert(before_step.end(), shape.values, shape.values + shape.size);
   }
 
   void RestoreValues() const {
     CHECK(!before_step.empty()) << "UndoStep without a step";
     auto value = before_step.begin();
-    for (const std::vector<double*>* blocks : {&layout.dense, &layout.eliminated}) {
-      for (double* block : *blocks) {
-        const int size = problem->ParameterBlockSize(block);
-        std::copy(value, value + size, block);
-        value += size;
-      }
+    for (const BlockShape& shape : shapes) {
+      std::copy(value, value + shape.size, shape.values);
+      value += shape.size;
     }
   }
 
@@ -157,11 +175,11 @@ struct GaussNewtonSolver::System {
     Eigen::VectorXd dx;
     equations.BackSubstitute(dx_dense, &dx);
     if (!dx.allFinite()) return step;
-    step.values_norm = std::sqrt(SquaredNorm(*problem, layout.dense) + SquaredNorm(*problem, layout.eliminated));
+    const size_t dense = layout.dense.size();
+    step.values_norm = std::sqrt(SquaredNorm(shapes, 0, dense) + SquaredNorm(shapes, dense, shapes.size()));
     step.step_norm = dx.norm();
     SaveValues();
-    ApplyStep(problem, layout.dense, dx, 0);
-    ApplyStep(problem, layout.eliminated, dx, equations.dense_dim());
+    ApplyStep(shapes, dx);
     step.ok = true;
     return step;
   }

@@ -1,8 +1,9 @@
 #include "vio/estimator/stereo_motion.h"
 
 #include <algorithm>
-#include <map>
+#include <optional>
 #include <sstream>
+#include <vector>
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
@@ -41,35 +42,54 @@ double StereoPointSigma(double depth_m, const RectifiedStereo& stereo, double pi
   return std::sqrt(lateral * lateral + along * along);
 }
 
-std::map<LandmarkId, Eigen::Vector3d> StereoPointsInCamera(const StereoFrame& frame, const RectifiedStereo& stereo,
-                                                           const ModelOptions& model) {
-  std::map<LandmarkId, Eigen::Vector3d> points;
-  for (const StereoObservation& obs : frame.observations) {
-    const std::optional<Eigen::Vector3d> p_cl = TriangulateRectified(obs.z_px, stereo, model.min_disparity_px);
-    if (p_cl && p_cl->z() <= model.max_depth_m) points[obs.landmark] = *p_cl;
-  }
-  return points;
-}
+// A landmark's stereo point in the left camera and the frame's (first) observation of it.
+struct StereoPointInCamera {
+  LandmarkId id;
+  std::optional<Eigen::Vector3d> p_cl;  ///< none: no point within the depth limits
+  Eigen::Vector3d z_px;
+};
 
-Eigen::Vector3d ObservationOf(const StereoFrame& frame, LandmarkId id) {
+// The frame's stereo points in the left camera, in landmark id order; of an id observed more
+// than once, the point of its last observation that has one, with its first observation.
+std::vector<StereoPointInCamera> StereoPointsInCamera(const StereoFrame& frame, const RectifiedStereo& stereo,
+                                              const ModelOptions& model) {
+  std::vector<StereoPointInCamera> points;
+  points.reserve(frame.observations.size());
   for (const StereoObservation& obs : frame.observations) {
-    if (obs.landmark == id) return obs.z_px;
+    std::optional<Eigen::Vector3d> p_cl = TriangulateRectified(obs.z_px, stereo, model.min_disparity_px);
+    if (p_cl && !(p_cl->z() <= model.max_depth_m)) p_cl.reset();
+    points.push_back({obs.landmark, p_cl, obs.z_px});
   }
-  return Eigen::Vector3d::Zero();
+  const auto by_id = [](const StereoPointInCamera& a, const StereoPointInCamera& b) { return a.id < b.id; };
+  if (!std::is_sorted(points.begin(), points.end(), by_id)) std::stable_sort(points.begin(), points.end(), by_id);
+  size_t kept = 0;
+  for (size_t k = 0; k < points.size(); ++k) {
+    if (kept > 0 && points[kept - 1].id == points[k].id) {  // a repeated id keeps its first observation
+      if (points[k].p_cl) points[kept - 1].p_cl = points[k].p_cl;
+      continue;
+    }
+    points[kept++] = points[k];
+  }
+  points.resize(kept);
+  points.erase(std::remove_if(points.begin(), points.end(), [](const StereoPointInCamera& p) { return !p.p_cl; }),
+               points.end());
+  return points;
 }
 
 std::vector<PointPair> SharedPoints(const StereoFrame& a, const StereoFrame& b, const RectifiedStereo& stereo,
                                     const ModelOptions& model) {
-  const std::map<LandmarkId, Eigen::Vector3d> in_a = StereoPointsInCamera(a, stereo, model);
-  const std::map<LandmarkId, Eigen::Vector3d> in_b = StereoPointsInCamera(b, stereo, model);
+  const std::vector<StereoPointInCamera> in_a = StereoPointsInCamera(a, stereo, model);
+  const std::vector<StereoPointInCamera> in_b = StereoPointsInCamera(b, stereo, model);
   std::vector<PointPair> pairs;
-  for (const auto& [id, p_cl_a] : in_a) {
-    const auto it = in_b.find(id);
-    if (it == in_b.end()) continue;
-    const double sa = StereoPointSigma(p_cl_a.z(), stereo, model.pixel_sigma);
-    const double sb = StereoPointSigma(it->second.z(), stereo, model.pixel_sigma);
-    pairs.push_back({stereo.T_b_cl * p_cl_a, stereo.T_b_cl * it->second, std::sqrt(sa * sa + sb * sb),
-                     ObservationOf(a, id), ObservationOf(b, id)});
+  auto it = in_b.begin();
+  for (const StereoPointInCamera& point_a : in_a) {
+    while (it != in_b.end() && it->id < point_a.id) ++it;
+    if (it == in_b.end()) break;
+    if (it->id != point_a.id) continue;
+    const double sa = StereoPointSigma(point_a.p_cl->z(), stereo, model.pixel_sigma);
+    const double sb = StereoPointSigma(it->p_cl->z(), stereo, model.pixel_sigma);
+    pairs.push_back({stereo.T_b_cl * *point_a.p_cl, stereo.T_b_cl * *it->p_cl, std::sqrt(sa * sa + sb * sb),
+                     point_a.z_px, it->z_px});
   }
   return pairs;
 }

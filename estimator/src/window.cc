@@ -1,6 +1,7 @@
 #include "vio/estimator/window.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -172,26 +173,27 @@ void Window::AddObservation(StateId state_id, LandmarkId landmark_id, const Eige
   State& s = state(state_id);
   auto it = landmarks_.find(landmark_id);
   CHECK(it != landmarks_.end()) << "observation of unknown landmark " << landmark_id.value;
-  const ObservationKey key{state_id, landmark_id};
-  CHECK(observations_.count(key) == 0) << "landmark " << landmark_id.value << " observed twice in state "
-                                      << state_id.value;
-  // The pose, the landmark, then the calibration blocks in CalibrationBlocks()' order.
-  constexpr std::size_t kMostBlocks = 4;
-  std::vector<double*> blocks;
+  const auto [entry, added] = observations_.try_emplace({state_id, landmark_id});
+  CHECK(added) << "landmark " << landmark_id.value << " observed twice in state " << state_id.value;
+  // The pose, the landmark, then the calibration blocks in CalibrationBlocks()' order; their keys
+  // only for first estimates.
+  constexpr int kMostBlocks = 4;
+  std::array<double*, kMostBlocks> blocks{s.pose, it->second.p_w};
+  int count = 2;
   std::vector<BlockKey> keys;
-  blocks.reserve(kMostBlocks);
-  keys.reserve(kMostBlocks);
-  blocks.push_back(s.pose);
-  blocks.push_back(it->second.p_w);
-  const auto point = PointKeys(state_id, landmark_id);
-  keys.assign(point.begin(), point.end());
-  for (const auto& [block, key] : KeyedCalibrationBlocks()) {
-    blocks.push_back(block);
-    keys.push_back(key);
+  if (first_estimates_) {
+    const auto point = PointKeys(state_id, landmark_id);
+    keys.assign(point.begin(), point.end());
   }
-  const ceres::ResidualBlockId residual = problem_->AddResidualBlock(
-      WithFirstEstimates(Wrap(StereoFactorOf(state_id, landmark_id, z_px)), std::move(keys)), loss_.get(), blocks);
-  observations_[key] = Observation{z_px, residual};
+  for (const auto& [block, block_key] : KeyedCalibrationBlocks()) {
+    CHECK_LT(count, kMostBlocks) << "more calibration blocks than an observation's factor takes";
+    blocks[static_cast<size_t>(count++)] = block;
+    if (first_estimates_) keys.push_back(block_key);
+  }
+  ceres::CostFunction* factor = Wrap(StereoFactorOf(state_id, landmark_id, z_px));
+  if (first_estimates_) factor = WithFirstEstimates(factor, std::move(keys));
+  const ceres::ResidualBlockId residual = problem_->AddResidualBlock(factor, loss_.get(), blocks.data(), count);
+  entry->second = Observation{z_px, residual};
   it->second.observed_from.insert(state_id);
 }
 

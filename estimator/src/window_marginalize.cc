@@ -39,8 +39,9 @@ void Window::Marginalize(const std::vector<StateId>& state_ids, const std::vecto
   std::vector<double*> blocks = Blocks(state_ids, landmark_ids);
   if (blocks.empty()) return;
   const Leaving leaving = LeavingOf(state_ids, landmark_ids);
-  KeyedResiduals residuals = ResidualOrderOf(leaving);
-  ForgetResidualsOf(leaving);
+  const LeavingKeys keys = LeavingKeysOf(leaving);
+  KeyedResiduals residuals = ResidualOrderOf(leaving, keys);
+  ForgetResidualsOf(leaving, keys);
   std::vector<BlockKey> kept_order;
   const ceres::ResidualBlockId prior = MarginalizeEvaluable(blocks, std::move(residuals), leaving, &kept_order);
   last_prior_rank_deficient_ = false;
@@ -90,6 +91,7 @@ marginalization::MarginalizationOptions Window::MarginalizationOptionsOf(const K
                                                                          std::vector<BlockKey>* kept_order) {
   marginalization::MarginalizationOptions options;
   options.residual_order = residuals.ids;
+  options.residual_order_is_exact = true;  // every residual of what leaves, by the window's bookkeeping
   *kept_order = KeptOrderOf(residuals, leaving);
   for (const BlockKey& key : *kept_order) {
     options.kept_order.push_back(BlockOf(key));
@@ -126,12 +128,14 @@ void Window::KeepPrior(ceres::ResidualBlockId prior, const std::vector<BlockKey>
 
 // Drops the bookkeeping of every residual of what leaves; the residual blocks
 // themselves go with their parameter blocks.
-void Window::ForgetResidualsOf(const Leaving& leaving) {
-  for (const ObservationKey& key : ObservationKeysOf(leaving)) {
+void Window::ForgetResidualsOf(const Leaving& leaving) { ForgetResidualsOf(leaving, LeavingKeysOf(leaving)); }
+
+void Window::ForgetResidualsOf(const Leaving& leaving, const LeavingKeys& keys) {
+  for (const ObservationKey& key : keys.observations) {
     landmarks_.at(key.second).observed_from.erase(key.first);
     observations_.erase(key);
   }
-  for (const ObservationKey& key : AnchoredKeysOf(leaving)) {
+  for (const ObservationKey& key : keys.anchored) {
     landmarks_.at(key.second).anchored_to.erase(key.first);
     anchored_points_.erase(key);
   }

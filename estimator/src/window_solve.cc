@@ -82,7 +82,11 @@ bool Window::Touches(StateId to, const ImuEdge& edge, const Leaving& leaving) co
   return leaving.states.count(edge.from) > 0 || leaving.states.count(to) > 0;
 }
 
-KeyedResiduals Window::ResidualOrderOf(const Leaving& leaving) const {
+Window::LeavingKeys Window::LeavingKeysOf(const Leaving& leaving) const {
+  return {ObservationKeysOf(leaving), AnchoredKeysOf(leaving)};
+}
+
+KeyedResiduals Window::ResidualOrderOf(const Leaving& leaving, const LeavingKeys& keys) const {
   KeyedResiduals order;
   for (const Prior& prior : priors_) {
     if (Touches(prior, leaving)) order.Add(prior.residual, prior.keys);
@@ -91,10 +95,10 @@ KeyedResiduals Window::ResidualOrderOf(const Leaving& leaving) const {
     if (Touches(to, edge, leaving)) order.Add(edge.residual, ImuKeys(edge.from, to));
   }
   const std::vector<BlockKey> calibration = CalibrationKeys();
-  for (const auto& [state, landmark] : ObservationKeysOf(leaving)) {
+  for (const auto& [state, landmark] : keys.observations) {
     order.Add(observations_.at({state, landmark}).residual, PointKeys(state, landmark), calibration);
   }
-  AddAnchoredPoints(AnchoredKeysOf(leaving), &order);
+  AddAnchoredPoints(keys.anchored, &order);
   return order;
 }
 

@@ -134,7 +134,8 @@ void AddResiduals(const ceres::Problem& window, const KeyedResiduals& residuals,
 SolveReport Window::SolveSparse(const SolverOptions& options) {
   const VariableIds variable = VariableIdsOf();
   if (variable.states.empty() && variable.landmarks.empty()) return SolveReport();
-  return SolveCopy(options, ResidualOrderOf(SolvedOf(variable)), {});
+  const Leaving solved = SolvedOf(variable);
+  return SolveCopy(options, ResidualOrderOf(solved, LeavingKeysOf(solved)), {});
 }
 
 Window::Leaving Window::SolvedOf(const VariableIds& variable) {

@@ -189,10 +189,11 @@ void BlockSystem::Impl::Accumulate(const Residual& residual, const Residuals& re
 // MarginalizationPrior::Linearize) without forming Jp T: its blocks' parts
 // go where a residual's J_i^T J_j would (H, b, or the eliminated block's H, b
 // and couplings W).
+// `cost` null: not wanted (the prior's is then not formed).
 bool BlockSystem::Impl::AddPrior(const Residual& residual, double* cost) {
   const MarginalizationPrior& prior = *residual.prior;
-  if (!prior.Linearize(residual.values, &prior_linearization)) return false;
-  *cost = prior_linearization.cost;
+  if (!prior.Linearize(residual.values, &prior_linearization, /*with_cost=*/cost != nullptr)) return false;
+  if (cost != nullptr) *cost = prior_linearization.cost;
   const int n = static_cast<int>(residual.slots.size);
   // use(block (i, j) of the prior's J^T J): the stored information itself
   // where both T are the identity (Euclidean blocks, FEJ), else T_i^T I_ij T_j.
@@ -310,15 +311,19 @@ bool BlockSystem::Impl::AssembledFinite() const {
   return true;
 }
 
+// `cost` null: the cost is not wanted (a marginalization's).
 bool BlockSystem::Impl::Assemble(double* cost) {
   if (!RefreshPlusJacobians()) return false;
   Zero();
-  *cost = 0;
+  double total = 0;
   for (const Residual& residual : residuals) {
     double c = 0;
-    if (!(residual.prior != nullptr ? AddPrior(residual, &c) : AddGeneric(residual, &c))) return false;
-    *cost += c;
+    if (!(residual.prior != nullptr ? AddPrior(residual, cost != nullptr ? &c : nullptr) : AddGeneric(residual, &c))) {
+      return false;
+    }
+    total += c;
   }
+  if (cost != nullptr) *cost = total;
   return AssembledFinite();
 }
 

@@ -29,7 +29,7 @@ struct SignificantEigenpairs {
 };
 
 void RequireFinite(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, const char* where) {
-  if (!H.allFinite() || !b.allFinite()) {
+  if (!AllFinite(H) || !AllFinite(b)) {
     throw std::invalid_argument(std::string(where) +
                                 ": information matrix or vector is not finite");
   }
@@ -321,7 +321,7 @@ std::optional<NormalEquations> SchurComplementByCholesky(const Eigen::MatrixXd& 
 }  // namespace
 
 Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& H, const RankThreshold& threshold) {
-  if (!H.allFinite() || H.rows() != H.cols()) {
+  if (!AllFinite(H) || H.rows() != H.cols()) {
     throw std::invalid_argument("PseudoInverse: expected a finite square matrix");
   }
   if (H.rows() == 3) return PseudoInverse3(H, threshold);

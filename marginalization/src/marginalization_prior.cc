@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "vio/marginalization/linear_algebra.h"
 #include "vio/marginalization/local_coordinates_jacobian.h"
 
 namespace vio::marginalization {
@@ -52,7 +53,7 @@ void ValidatePrior(const std::vector<MarginalizationPrior::Block>& blocks,
             << " rows; expected rows > 0, equal, and " << tangent_dim << " columns";
     throw std::invalid_argument(message.str());
   }
-  if (!sqrt_information.allFinite() || !residual_at_x0.allFinite()) {
+  if (!AllFinite(sqrt_information) || !AllFinite(residual_at_x0)) {
     throw std::invalid_argument("MarginalizationPrior: non-finite sqrt_information or residual");
   }
 }
@@ -73,7 +74,7 @@ std::unique_ptr<MarginalizationPrior> MarginalizationPrior::Create(std::vector<B
                                                                    Eigen::MatrixXd information) {
   ValidatePrior(blocks, sqrt_information, residual_at_x0);
   if (information.rows() != sqrt_information.cols() || information.cols() != sqrt_information.cols() ||
-      !information.allFinite()) {
+      !AllFinite(information)) {
     std::ostringstream message;
     message << "MarginalizationPrior: information is " << information.rows() << "x" << information.cols()
             << "; expected a finite " << sqrt_information.cols() << "x" << sqrt_information.cols() << " matrix";
@@ -121,11 +122,19 @@ bool MarginalizationPrior::TangentJacobians(double const* const* parameters, Eig
   return true;
 }
 
-bool MarginalizationPrior::Linearize(double const* const* parameters, TangentLinearization* at) const {
+bool MarginalizationPrior::Linearize(double const* const* parameters, TangentLinearization* at,
+                                     bool with_cost) const {
   Eigen::VectorXd delta;
   if (!TangentJacobians(parameters, &delta, &at->T)) return false;
-  at->cost = 0.5 * (residual_at_x0_ + sqrt_information_ * delta).squaredNorm();
-  at->g = information_vector_ + information_ * delta;
+  if (delta.isZero(0.0)) {
+    // At x0 (a prior's first solve): the products with delta are exact zeros, and adding them
+    // changes only a -0 into +0, as adding 0.0 does.
+    at->cost = with_cost ? 0.5 * residual_at_x0_.squaredNorm() : 0.0;
+    at->g = (information_vector_.array() + 0.0).matrix();
+  } else {
+    at->cost = with_cost ? 0.5 * (residual_at_x0_ + sqrt_information_ * delta).squaredNorm() : 0.0;
+    at->g = information_vector_ + information_ * delta;
+  }
   for (size_t i = 0; i < blocks_.size(); ++i) {
     Eigen::MatrixXd& T = at->T[i];
     if (T.isIdentity(0.0)) {

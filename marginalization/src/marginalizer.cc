@@ -42,6 +42,7 @@ std::vector<double*> UniqueBlocksInProblem(const ceres::Problem& problem,
                                            const std::vector<double*>& blocks) {
   std::vector<double*> unique;
   BlockSet seen;
+  seen.reserve(blocks.size());
   for (double* block : blocks) {
     if (!problem.HasParameterBlock(block)) {
       std::ostringstream message;
@@ -58,8 +59,11 @@ std::vector<double*> UniqueBlocksInProblem(const ceres::Problem& problem,
 
 std::vector<ceres::ResidualBlockId> ResidualBlocksTouching(const ceres::Problem& problem,
                                                            const std::vector<double*>& marg,
-                                                           const std::vector<ceres::ResidualBlockId>& order) {
+                                                           const std::vector<ceres::ResidualBlockId>& order,
+                                                           bool order_is_exact) {
+  if (order_is_exact) return order;  // FindMarkovBlanket checks that each touches a marginalized block
   std::unordered_set<ceres::ResidualBlockId> touching;
+  touching.reserve(order.size());
   std::vector<ceres::ResidualBlockId> of_block;
   for (const double* block : marg) {
     problem.GetResidualBlocksForParameterBlock(block, &of_block);
@@ -143,10 +147,14 @@ void OrderKept(const std::vector<const double*>& order, std::vector<double*>* ke
 MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector<double*>& marg,
                                 const MarginalizationOptions& options) {
   MarkovBlanket blanket;
-  blanket.residual_blocks = ResidualBlocksTouching(problem, marg, options.residual_order);
+  blanket.residual_blocks =
+      ResidualBlocksTouching(problem, marg, options.residual_order, options.residual_order_is_exact);
   std::unordered_map<const double*, int> marg_index;
   marg_index.reserve(marg.size());
   for (size_t k = 0; k < marg.size(); ++k) marg_index.emplace(marg[k], static_cast<int>(k));
+  // Whether each marginalized block is variable, looked up once (not once per residual touching it).
+  std::vector<char> marg_is_variable(marg.size());
+  for (size_t k = 0; k < marg.size(); ++k) marg_is_variable[k] = IsVariable(problem, marg[k]) ? 1 : 0;
   BlockSet kept_seen;
   std::vector<std::pair<int, int>> pairs;
   std::vector<double*> touched;
@@ -154,16 +162,17 @@ MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector
   for (const ceres::ResidualBlockId residual_block : blanket.residual_blocks) {
     problem.GetParameterBlocksForResidualBlock(residual_block, &touched);
     marg_here.clear();
+    bool touches_marg = false;
     for (double* block : touched) {
-      if (!IsVariable(problem, block)) {
-        continue;
-      }
       if (const auto it = marg_index.find(block); it != marg_index.end()) {
-        marg_here.push_back(it->second);
-      } else if (kept_seen.insert(block).second) {
+        touches_marg = true;
+        if (marg_is_variable[static_cast<size_t>(it->second)] != 0) marg_here.push_back(it->second);
+      } else if (kept_seen.count(block) == 0 && IsVariable(problem, block)) {  // a variable blanket block, first seen
+        kept_seen.insert(block);
         blanket.kept.push_back(block);
       }
     }
+    CHECK(touches_marg) << "residual_order_is_exact: a residual of the order touches no marginalized block";
     for (const int a : marg_here) {
       for (const int b : marg_here) {
         if (a != b) pairs.emplace_back(a, b);
@@ -173,7 +182,7 @@ MarkovBlanket FindMarkovBlanket(const ceres::Problem& problem, const std::vector
   OrderKept(options.kept_order, &blanket.kept, &blanket.kept_place);
   std::vector<int> marg_variable;
   for (size_t k = 0; k < marg.size(); ++k) {
-    if (IsVariable(problem, marg[k])) marg_variable.push_back(static_cast<int>(k));
+    if (marg_is_variable[k] != 0) marg_variable.push_back(static_cast<int>(k));
   }
   SplitMarginalized(problem, marg, marg_variable, Couplings(marg.size(), std::move(pairs)), &blanket);
   return blanket;
@@ -207,8 +216,7 @@ NormalEquations ReducedBlanket(ceres::Problem* problem, const MarkovBlanket& bla
   } else {
     system = &own.emplace(problem, std::move(layout), options.rank_threshold);
   }
-  double cost = 0.0;
-  if (!system->Reduce(&cost)) {
+  if (!system->Reduce(/*cost=*/nullptr)) {
     throw std::runtime_error("marginalization: the Markov blanket's residuals do not evaluate (or are not finite)");
   }
   NormalEquations reduced;
@@ -279,16 +287,12 @@ std::unique_ptr<MarginalizationPrior> BuildPrior(ceres::Problem* problem,
   return prior;
 }
 
-}  // namespace
-
-MarginalizationResult ComputeMarginalization(ceres::Problem* problem,
-                                             const std::vector<double*>& to_marginalize,
-                                             const MarginalizationOptions& options) {
-  CHECK(problem != nullptr);
+/// ComputeMarginalization of blocks that are in the problem, each once.
+MarginalizationResult MarginalizationOfUnique(ceres::Problem* problem, const std::vector<double*>& marg,
+                                              const MarginalizationOptions& options) {
   if (!options.first_estimates.empty() && options.first_estimates.size() != options.kept_order.size()) {
     throw std::invalid_argument("marginalization: first_estimates and kept_order differ in length");
   }
-  const std::vector<double*> marg = UniqueBlocksInProblem(*problem, to_marginalize);
   MarkovBlanket blanket = FindMarkovBlanket(*problem, marg, options);
   MarginalizationResult result;
   result.marginalized_residual_blocks = blanket.residual_blocks;
@@ -301,13 +305,29 @@ MarginalizationResult ComputeMarginalization(ceres::Problem* problem,
   return result;
 }
 
+}  // namespace
+
+MarginalizationResult ComputeMarginalization(ceres::Problem* problem,
+                                             const std::vector<double*>& to_marginalize,
+                                             const MarginalizationOptions& options) {
+  CHECK(problem != nullptr);
+  return MarginalizationOfUnique(problem, UniqueBlocksInProblem(*problem, to_marginalize), options);
+}
+
 ceres::ResidualBlockId MarginalizeBlocks(ceres::Problem* problem,
                                          const std::vector<double*>& to_marginalize,
                                          const MarginalizationOptions& options) {
-  MarginalizationResult result = ComputeMarginalization(problem, to_marginalize, options);
-  for (const double* block : UniqueBlocksInProblem(*problem, to_marginalize)) {
+  CHECK(problem != nullptr);
+  const std::vector<double*> marg = UniqueBlocksInProblem(*problem, to_marginalize);
+  MarginalizationResult result = MarginalizationOfUnique(problem, marg, options);
+  const int residuals_before = problem->NumResidualBlocks();
+  for (const double* block : marg) {
     problem->RemoveParameterBlock(block);
   }
+  // Removing the blocks removed every residual on them: an exact order held them all.
+  CHECK_EQ(static_cast<size_t>(residuals_before - problem->NumResidualBlocks()),
+           result.marginalized_residual_blocks.size())
+      << "residual_order misses residual blocks of the marginalized blocks";
   if (result.prior == nullptr) {
     return nullptr;
   }

@@ -1,6 +1,7 @@
 // Relative stereo poses (stereo_motion.h): noise-free frames give the motion exactly; with pixel
 // noise the covariance-weighted fit's rotation is closer to the truth than the isotropic fit's
 // (whose depth errors along the rays turn it), on average over draws.
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -83,4 +84,27 @@ TEST(StereoMotion, TheWeightedFitsRotationIsCloserWithPixelNoise) {
 }
 
 }  // namespace
+TEST(StereoMotion, TheFramesObservationOrderDoesNotMatter) {
+  // The shared landmarks are matched by id: frames listing their observations in another order
+  // give the same poses, bit for bit.
+  std::mt19937 rng(3);
+  StereoFrame a, b;
+  MakeFrames(Motion(), 0.3, &rng, &a, &b);
+  StereoFrame a_shuffled = a, b_reversed = b;
+  std::shuffle(a_shuffled.observations.begin(), a_shuffled.observations.end(), rng);
+  std::reverse(b_reversed.observations.begin(), b_reversed.observations.end());
+  ModelOptions model;
+  int shared = 0, shared_shuffled = 0;
+  const auto plain = RelativeStereoPose(a, b, Rig(), model, 10, &shared);
+  const auto shuffled = RelativeStereoPose(a_shuffled, b_reversed, Rig(), model, 10, &shared_shuffled);
+  ASSERT_TRUE(plain && shuffled);
+  EXPECT_EQ(shared_shuffled, shared);
+  EXPECT_GT(shared, 10);
+  EXPECT_EQ(shuffled->T_a_b.matrix(), plain->T_a_b.matrix());
+  const auto weighted = WeightedRelativeStereoPose(a, b, Rig(), model, 10);
+  const auto weighted_shuffled = WeightedRelativeStereoPose(a_shuffled, b_reversed, Rig(), model, 10);
+  ASSERT_TRUE(weighted && weighted_shuffled);
+  EXPECT_EQ(weighted_shuffled->T_a_b.matrix(), weighted->T_a_b.matrix());
+}
+
 }  // namespace vio

@@ -33,6 +33,22 @@ NormalEquations RandomNormalEquations(int rows, int dim, std::mt19937* rng) {
   return {J.transpose() * J, J.transpose() * r};
 }
 
+TEST(AllFinite, AgreesWithEigensAllFinite) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double largest = std::numeric_limits<double>::max();
+  for (const double value : {0.0, -0.0, 1.0, -largest, largest, std::numeric_limits<double>::denorm_min(), inf, -inf,
+                             nan}) {
+    Eigen::MatrixXd m = Eigen::MatrixXd::Constant(7, 5, largest);  // sums of such overflow; their products by 0 do not
+    m(3, 2) = value;
+    EXPECT_EQ(AllFinite(m), m.allFinite()) << value;
+    Eigen::VectorXd v = Eigen::VectorXd::Ones(9);
+    v[8] = value;
+    EXPECT_EQ(AllFinite(v), v.allFinite()) << value;
+  }
+  EXPECT_TRUE(AllFinite(Eigen::MatrixXd(0, 0)));
+}
+
 TEST(SchurComplement, EqualsInverseOfMarginalCovarianceAndKeepsTheMinimizer) {
   std::mt19937 rng(1);
   const int keep = 4, marg = 5;

@@ -264,6 +264,45 @@ TEST_F(MarginalizationPriorTest, TangentLinearizationIsTheJacobianProducts) {
   EXPECT_NEAR(at.cost, 0.5 * r.squaredNorm(), 1e-12 * at.cost);
 }
 
+TEST(MarginalizationPriorLinearize, AtX0IsTheGeneralFormulaBitForBit) {
+  // At x0 (delta exactly 0 on Euclidean blocks) the products with delta are skipped: g and the
+  // cost are exactly what the general formula gives there, signs of zero included.
+  Eigen::MatrixXd Jp(4, 5);
+  Jp << 1.5, -0.25, 0, 2, 0.125, 0, 3, -1, 0.5, 0, 0, 0, 2.5, -0.75, 1, 0, 0, 0, 4, -2;
+  Eigen::VectorXd r0(4);
+  r0 << 0.5, -0.0, 1.25, -3;
+  const std::vector<double> a{1, 2, 3};
+  const std::vector<double> b{-1, 0.5};
+  const auto prior = MarginalizationPrior::Create({{nullptr, a}, {nullptr, b}}, Jp, r0);
+  const double* parameters[] = {a.data(), b.data()};
+  MarginalizationPrior::TangentLinearization at;
+  ASSERT_TRUE(prior->Linearize(parameters, &at));
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(5);
+  const Eigen::VectorXd g = prior->information_vector() + prior->information() * zero;
+  ASSERT_EQ(at.g.size(), g.size());
+  for (Eigen::Index k = 0; k < g.size(); ++k) {
+    EXPECT_EQ(at.g[k], g[k]) << k;
+    EXPECT_EQ(std::signbit(at.g[k]), std::signbit(g[k])) << k;
+  }
+  EXPECT_EQ(at.cost, 0.5 * (r0 + Jp * zero).squaredNorm());
+  for (const Eigen::MatrixXd& T : at.T) EXPECT_EQ(T.size(), 0);
+}
+
+TEST_F(MarginalizationPriorTest, LinearizationWithoutCostKeepsTheRest) {
+  const auto x = Perturbed(0.3);
+  std::vector<const double*> parameters;
+  for (const auto& block : x) parameters.push_back(block.data());
+  MarginalizationPrior::TangentLinearization with_cost;
+  MarginalizationPrior::TangentLinearization without_cost;
+  ASSERT_TRUE(prior_->Linearize(parameters.data(), &with_cost));
+  ASSERT_TRUE(prior_->Linearize(parameters.data(), &without_cost, /*with_cost=*/false));
+  EXPECT_GT(with_cost.cost, 0.0);
+  EXPECT_EQ(without_cost.cost, 0.0);
+  EXPECT_EQ(without_cost.g, with_cost.g);
+  ASSERT_EQ(without_cost.T.size(), with_cost.T.size());
+  for (size_t i = 0; i < with_cost.T.size(); ++i) EXPECT_EQ(without_cost.T[i], with_cost.T[i]) << i;
+}
+
 TEST_F(MarginalizationPriorTest, GivenInformationIsKeptAndChecked) {
   const Eigen::MatrixXd information = Jp_.transpose() * Jp_;
   std::vector<MarginalizationPrior::Block> blocks = prior_->blocks();

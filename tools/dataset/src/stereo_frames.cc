@@ -1,5 +1,6 @@
 #include "vio/dataset/stereo_frames.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -18,8 +19,9 @@ bool ConsistentIfSwapped(const PixelPair& pair, const frontend::StereoRectifier&
   return left && right && std::abs(left->y() - right->y()) <= max_epipolar_px && left->x() - right->x() > 0;
 }
 
-// One frame's rows (feature id -> pixels in cam0 / cam1) to measurements.
-void AddStereoObservations(const std::map<std::int64_t, PixelPair>& rows,
+// One frame's rows (feature id -> pixels in cam0 / cam1, in id order) to measurements.
+template <typename Rows>
+void AddStereoObservations(const Rows& rows,
                            const frontend::StereoRectifier& rectifier, double max_epipolar_px, StereoFrame* frame,
                            StereoFramesReport* report) {
   frame->observations.reserve(frame->observations.size() + rows.size());
@@ -47,16 +49,32 @@ void AddStereoObservations(const std::map<std::int64_t, PixelPair>& rows,
   }
 }
 
+// The rows of one frame's features by feature id, in id order, as a map of them would hold them
+// (a later row of an id and camera replaces an earlier one), without a node per row.
+std::vector<std::pair<std::int64_t, PixelPair>> RowsById(const std::vector<FeatureObservation>& features) {
+  std::vector<const FeatureObservation*> by_id;
+  by_id.reserve(features.size());
+  for (const FeatureObservation& obs : features) by_id.push_back(&obs);
+  std::stable_sort(by_id.begin(), by_id.end(), [](const FeatureObservation* a, const FeatureObservation* b) {
+    return a->feature_id < b->feature_id;
+  });
+  std::vector<std::pair<std::int64_t, PixelPair>> rows;
+  rows.reserve(by_id.size());
+  for (const FeatureObservation* obs : by_id) {
+    if (rows.empty() || rows.back().first != obs->feature_id) rows.emplace_back(obs->feature_id, PixelPair{});
+    rows.back().second.uv[obs->camera] = obs->uv_px;
+  }
+  return rows;
+}
+
 }  // namespace
 
 StereoFrame StereoFrameFromFeatures(Timestamp t_ns, const std::vector<FeatureObservation>& features,
                                     const frontend::StereoRectifier& rectifier, double max_epipolar_px,
                                     StereoFramesReport* report) {
-  std::map<std::int64_t, PixelPair> rows;
-  for (const FeatureObservation& obs : features) rows[obs.feature_id].uv[obs.camera] = obs.uv_px;
   StereoFrame frame;
   frame.t_ns = t_ns;
-  AddStereoObservations(rows, rectifier, max_epipolar_px, &frame, report);
+  AddStereoObservations(RowsById(features), rectifier, max_epipolar_px, &frame, report);
   return frame;
 }
 

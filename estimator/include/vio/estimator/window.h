@@ -112,7 +112,8 @@ struct WindowHealth {
 /// How the window's Ceres problem finds the residuals of a parameter block. kPerBlock: every
 /// block keeps the set of its residuals (Ceres' enable_fast_removal), so removing a state or
 /// landmark costs what it touches; about 130 B per observation. kNone: no sets; a removal scans
-/// every residual: for windows that keep everything and remove little (batch, the refinement).
+/// every residual: for windows that keep everything and remove little (batch, the refinement), or hold
+/// few residuals (the MSCKF without a local map: one frame's tracks).
 enum class ResidualIndex { kPerBlock, kNone };
 
 class Window {
@@ -349,8 +350,16 @@ class Window {
   /// observations by ids (never by address).
   std::vector<ceres::ResidualBlockId> ResidualOrder() const;
   Leaving LeavingOf(const std::vector<StateId>& states, const std::vector<LandmarkId>& landmarks);
-  /// ResidualOrder() restricted to the residuals of what leaves, with their blocks' keys.
-  KeyedResiduals ResidualOrderOf(const Leaving& leaving) const;
+  /// The observations and anchored points of what leaves, found once for a marginalization's
+  /// residual order and its bookkeeping.
+  struct LeavingKeys {
+    std::set<ObservationKey> observations;
+    std::set<ObservationKey> anchored;
+  };
+  LeavingKeys LeavingKeysOf(const Leaving& leaving) const;
+  /// ResidualOrder() restricted to the residuals of what leaves (`keys`: LeavingKeysOf(leaving)), with
+  /// their blocks' keys.
+  KeyedResiduals ResidualOrderOf(const Leaving& leaving, const LeavingKeys& keys) const;
   /// Appends the anchored points `keys` to `order`.
   void AddAnchoredPoints(const std::set<ObservationKey>& keys, KeyedResiduals* order) const;
   /// The blocks the residuals of what leaves touch that stay (its Markov blanket), in the
@@ -371,6 +380,7 @@ class Window {
   std::shared_ptr<ceres::ParameterBlockOrdering> StatesFirstOrdering() const;
   void ChooseLinearSolver(const std::string& linear_solver, ceres::Solver::Options* solver) const;
   void ForgetResidualsOf(const Leaving& leaving);
+  void ForgetResidualsOf(const Leaving& leaving, const LeavingKeys& keys);
   /// Removes the residuals that do not evaluate (finitely) at the current values from the problem and the list.
   void DropUnevaluableResiduals(KeyedResiduals* residuals);
   /// MarginalizeBlocks of what leaves over `residuals`, after DropUnevaluableResiduals only when it

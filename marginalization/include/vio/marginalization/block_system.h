@@ -56,7 +56,8 @@ class BlockSystem {
   void Relayout(BlockLayout layout, const RankThreshold& threshold);
   ceres::Problem* problem() const;
 
-  /// Assembles at the current values and eliminates; `cost` = 1/2 sum rho(|r|^2).
+  /// Assembles at the current values and eliminates; `cost` = 1/2 sum rho(|r|^2), or null
+  /// when not wanted (a prior's cost is then not formed: one n^2 product fewer).
   /// False when a residual does not evaluate or gives a non-finite value.
   bool Reduce(double* cost);
   /// J^T J reduced to the dense columns; only its upper triangle is kept.

@@ -91,8 +91,9 @@ class MarginalizationPrior final : public ceres::CostFunction {
     double cost = 0.0;
   };
   /// The prior at `parameters`; O(n^2), no Jp T formed. False when a block's
-  /// local coordinates do not evaluate.
-  bool Linearize(double const* const* parameters, TangentLinearization* at) const;
+  /// local coordinates do not evaluate. Without `with_cost`, `at->cost` is 0 (one n^2 product
+  /// fewer: a marginalization needs no cost).
+  bool Linearize(double const* const* parameters, TangentLinearization* at, bool with_cost = true) const;
   /// Block (i, j) of J^T J at `at`: T_i^T information()_ij T_j.
   void TangentHessianBlock(const TangentLinearization& at, int i, int j, Eigen::MatrixXd* block) const;
   /// Column of block i in sqrt_information().

@@ -43,6 +43,10 @@ struct MarginalizationOptions {
   /// hold every residual block touching a marginalized block). Empty: the
   /// problem's order, which Ceres' block removal makes depend on addresses.
   std::vector<ceres::ResidualBlockId> residual_order;
+  /// residual_order holds exactly the residual blocks touching a marginalized block (the caller keeps
+  /// that bookkeeping): the problem is not asked for them. Without Ceres' enable_fast_removal the
+  /// problem keeps no residuals per block, and asking scans every residual once per block.
+  bool residual_order_is_exact = false;
   /// The kept blocks' column order, when not empty: the kept blocks listed
   /// here come first, in this order, then the others in order of first
   /// appearance. A window passes its state blocks with the poses last and the
